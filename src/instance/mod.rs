@@ -1,0 +1,365 @@
+//! The co-simulation slave: FMI 2.0's calls as methods on a typed instance, free of C types.
+//! Each method returns `Ok(status)` or an [`FmiError`] with its reason; the C layer turns
+//! them into fmi2Status and log lines. Which calls are allowed in which state is in
+//! [`state::allowed`]; the C layer checks it before calling in.
+
+pub mod error;
+pub mod simulation;
+pub mod state;
+pub mod values;
+
+pub use error::{FmiError, FmiResult, Status};
+pub use simulation::Simulation;
+pub use state::FmiState;
+
+use crate::contract::{self, Causality, Kind, LOG_CATEGORIES, vr};
+use crate::physics::Shaft;
+use values::Values;
+
+/// A line for the importer's logger.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Message {
+    pub status: Status,
+    pub category: &'static str,
+    pub text: String,
+}
+
+const ERRORS: usize = 0;
+const WARNINGS: usize = 1;
+const EVENTS: usize = 2;
+const STEPS: usize = 3;
+
+/// One co-simulation instance.
+#[derive(Clone, Debug)]
+pub struct Instance {
+    pub state: FmiState,
+    values: Values,
+    start_time: f64,
+    tolerance: Option<f64>,
+    /// The running model; built at fmi2ExitInitializationMode (and for reads during
+    /// initialisation, from the values set so far).
+    sim: Option<Simulation>,
+    last_successful_time: f64,
+    /// Log categories switched on, in the order of `LOG_CATEGORIES`.
+    logging: [bool; LOG_CATEGORIES.len()],
+    /// Lines waiting for the importer's logger.
+    pub messages: Vec<Message>,
+}
+
+impl Instance {
+    pub fn new(logging_on: bool) -> Self {
+        let mut logging = [logging_on; LOG_CATEGORIES.len()];
+        logging[ERRORS] = true;
+        logging[WARNINGS] = true;
+        Instance {
+            state: FmiState::Instantiated,
+            values: Values::start(),
+            start_time: 0.0,
+            tolerance: None,
+            sim: None,
+            last_successful_time: 0.0,
+            logging,
+            messages: Vec::new(),
+        }
+    }
+
+    /// Queues a line for the logger if its category is on (errors always are).
+    pub fn log(&mut self, status: Status, category: usize, text: impl FnOnce() -> String) {
+        if self.logging[category] {
+            self.messages.push(Message {
+                status,
+                category: LOG_CATEGORIES[category].0,
+                text: text(),
+            });
+        }
+    }
+
+    /// Queues the reason of a refused or failed call.
+    pub fn log_error(&mut self, error: &FmiError) {
+        let category = if error.status <= Status::Warning {
+            WARNINGS
+        } else {
+            ERRORS
+        };
+        self.log(error.status, category, || error.message.clone());
+    }
+
+    pub fn set_debug_logging(&mut self, on: bool, categories: &[String]) -> FmiResult {
+        let mut indices = Vec::with_capacity(categories.len());
+        for name in categories {
+            match LOG_CATEGORIES.iter().position(|(c, _)| c == name) {
+                Some(i) => indices.push(i),
+                None => {
+                    let declared: Vec<_> = LOG_CATEGORIES.iter().map(|(c, _)| *c).collect();
+                    return Err(FmiError::error(format!(
+                        "unknown log category \"{name}\"; declared: {}",
+                        declared.join(", ")
+                    )));
+                }
+            }
+        }
+        if indices.is_empty() {
+            indices.extend(0..LOG_CATEGORIES.len());
+        }
+        for i in indices {
+            // Errors are always reported: a refused call must say why.
+            self.logging[i] = on || i == ERRORS;
+        }
+        Ok(())
+    }
+
+    pub fn setup_experiment(&mut self, tolerance: Option<f64>, start_time: f64) -> FmiResult {
+        if !start_time.is_finite() {
+            return Err(FmiError::error(format!(
+                "startTime = {start_time} must be finite"
+            )));
+        }
+        if let Some(tol) = tolerance {
+            if !(tol > 0.0 && tol < 1.0) {
+                return Err(FmiError::error(format!(
+                    "tolerance = {tol:e} must lie in (0, 1)"
+                )));
+            }
+        }
+        self.start_time = start_time;
+        self.tolerance = tolerance;
+        Ok(())
+    }
+
+    pub fn enter_initialization_mode(&mut self) -> FmiResult {
+        self.state = FmiState::InitializationMode;
+        self.sim = None;
+        Ok(())
+    }
+
+    fn build(&self) -> FmiResult<Simulation> {
+        let rtol = self.tolerance.unwrap_or(contract::DEFAULT_TOLERANCE);
+        Simulation::new(&self.values, self.start_time, rtol)
+    }
+
+    /// Validates every parameter and builds the initial state; an invalid parameter is
+    /// refused and the instance stays in initialisation mode, where it can be corrected.
+    pub fn exit_initialization_mode(&mut self) -> FmiResult {
+        let sim = self.build()?;
+        self.sim = Some(sim);
+        self.last_successful_time = self.start_time;
+        self.state = FmiState::StepComplete;
+        Ok(())
+    }
+
+    pub fn terminate(&mut self) -> FmiResult {
+        self.state = FmiState::Terminated;
+        Ok(())
+    }
+
+    /// Back to the state after instantiation: start values, no time, no counters.
+    pub fn reset(&mut self) -> FmiResult {
+        *self = Instance {
+            logging: self.logging,
+            messages: std::mem::take(&mut self.messages),
+            ..Instance::new(false)
+        };
+        Ok(())
+    }
+
+    /// The running simulation, or during initialisation one built from the values so far.
+    fn current(&mut self) -> FmiResult<&Simulation> {
+        if self.sim.is_none() {
+            self.sim = Some(self.build()?);
+        }
+        Ok(self.sim.as_ref().expect("built above"))
+    }
+
+    fn variable(kind: Kind, vr: u32) -> FmiResult<&'static contract::Variable> {
+        contract::find(kind, vr).ok_or_else(|| {
+            FmiError::error(format!("unknown value reference {vr} for type {kind:?}"))
+        })
+    }
+
+    pub fn get_real(&mut self, vrs: &[u32], out: &mut [f64]) -> FmiResult {
+        for (vr, out) in vrs.iter().zip(out) {
+            let var = Self::variable(Kind::Real, *vr)?;
+            *out = match var.causality {
+                Causality::Output => self
+                    .current()?
+                    .real_output(*vr)
+                    .expect("every Real output of the contract is computed"),
+                _ => self.values.real(*vr),
+            };
+        }
+        Ok(())
+    }
+
+    pub fn get_integer(&mut self, vrs: &[u32], out: &mut [i32]) -> FmiResult {
+        for (vr, out) in vrs.iter().zip(out) {
+            let var = Self::variable(Kind::Integer, *vr)?;
+            let value = match var.causality {
+                Causality::Output => self
+                    .current()?
+                    .integer_output(*vr)
+                    .expect("every Integer output of the contract is computed"),
+                _ => self.values.integer(*vr),
+            };
+            *out = i32::try_from(value).unwrap_or(i32::MAX);
+        }
+        Ok(())
+    }
+
+    /// Checks that `var` may be set now.
+    fn settable(&self, var: &contract::Variable) -> FmiResult {
+        match var.causality {
+            Causality::Output => Err(FmiError::error(format!(
+                "{} is an output: it cannot be set",
+                var.name
+            ))),
+            Causality::Parameter if self.state == FmiState::StepComplete => {
+                Err(FmiError::error(format!(
+                    "{} is a fixed parameter: set it before fmi2ExitInitializationMode",
+                    var.name
+                )))
+            }
+            _ => Ok(()),
+        }
+    }
+
+    /// Sets Real parameters or inputs. The whole call is checked first, so a refused call
+    /// changes nothing.
+    pub fn set_real(&mut self, vrs: &[u32], values: &[f64]) -> FmiResult {
+        for (vr, value) in vrs.iter().zip(values) {
+            let var = Self::variable(Kind::Real, *vr)?;
+            self.settable(var)?;
+            if !value.is_finite() {
+                return Err(FmiError::error(format!(
+                    "{} = {value} refused: values must be finite",
+                    var.name
+                )));
+            }
+        }
+        let mut shaft_changed = false;
+        for (vr, value) in vrs.iter().zip(values) {
+            self.values.set_real(*vr, *value);
+            shaft_changed |= matches!(*vr, vr::theta_M | vr::omega_M | vr::alpha_M);
+        }
+        match self.state {
+            FmiState::StepComplete if shaft_changed => {
+                let shaft = Shaft {
+                    theta: self.values.real(vr::theta_M),
+                    omega: self.values.real(vr::omega_M),
+                    alpha: self.values.real(vr::alpha_M),
+                };
+                let sim = self.sim.as_mut().expect("initialised");
+                let before = sim.rattle.impacts;
+                sim.set_shaft(shaft);
+                let after = sim.rattle.impacts;
+                if before != after {
+                    self.log(Status::Ok, EVENTS, || {
+                        "new inputs moved the gear pair across a contact onset".to_string()
+                    });
+                }
+            }
+            FmiState::InitializationMode => self.sim = None,
+            _ => {}
+        }
+        Ok(())
+    }
+
+    pub fn set_integer(&mut self, vrs: &[u32], values: &[i32]) -> FmiResult {
+        for vr in vrs {
+            let var = Self::variable(Kind::Integer, *vr)?;
+            self.settable(var)?;
+        }
+        for (vr, value) in vrs.iter().zip(values) {
+            self.values.set_integer(*vr, *value as i64);
+        }
+        if self.state == FmiState::InitializationMode {
+            self.sim = None;
+        }
+        Ok(())
+    }
+
+    /// Refuses any value reference: the model has no Boolean or String variables.
+    pub fn no_variables_of(kind: &str, vrs: &[u32]) -> FmiResult {
+        match vrs.first() {
+            Some(vr) => Err(FmiError::error(format!(
+                "unknown value reference {vr} for type {kind}: the model has no {kind} variables"
+            ))),
+            None => Ok(()),
+        }
+    }
+
+    /// Main inputs coherent with the previous values: `theta_M` and `omega_M` follow the
+    /// extrapolation when the master does not set them again (see `Simulation::step_to`).
+    fn sync_inputs(&mut self) {
+        if let Some(sim) = &self.sim {
+            if let simulation::Drive::Inputs(shaft) = sim.drive {
+                self.values.set_real(vr::theta_M, shaft.theta);
+                self.values.set_real(vr::omega_M, shaft.omega);
+            }
+        }
+    }
+
+    pub fn do_step(&mut self, current: f64, h: f64) -> FmiResult {
+        if !(h > 0.0 && h.is_finite()) {
+            return Err(FmiError::error(format!(
+                "communicationStepSize = {h:e} refused: it must be finite and > 0"
+            )));
+        }
+        let sim = self.sim.as_mut().expect("initialised");
+        let drift = (current - sim.t).abs();
+        if !current.is_finite() || drift > 1e-9 * sim.t.abs().max(h).max(1e-3) {
+            return Err(FmiError::error(format!(
+                "currentCommunicationPoint = {current} does not match the instance's time {}",
+                sim.t
+            )));
+        }
+        sim.t = current;
+        let t_end = current + h;
+        let before = *sim;
+        match sim.step_to(t_end) {
+            Ok(()) => {
+                self.last_successful_time = t_end;
+                self.sync_inputs();
+                let sim = self.sim.as_ref().expect("initialised");
+                let (stats, impacts, h_next) = (
+                    sim.solver.stats,
+                    sim.rattle.impacts,
+                    sim.solver.proposed_step(),
+                );
+                let new = [
+                    impacts.count[0] - before.rattle.impacts.count[0],
+                    impacts.count[1] - before.rattle.impacts.count[1],
+                ];
+                if new != [0, 0] {
+                    self.log(Status::Ok, EVENTS, || {
+                        format!(
+                            "t = {t_end}: {} impact(s) on F+, {} on F-, last at |xi'| = {:e} m/s",
+                            new[0], new[1], impacts.last_speed
+                        )
+                    });
+                }
+                self.log(Status::Ok, STEPS, || {
+                    format!(
+                        "t = {t_end}: {} accepted, {} rejected steps, {} edges, {} rhs evaluations in total; next step {:e} s",
+                        stats.accepted,
+                        stats.rejected,
+                        stats.edges,
+                        stats.rhs_evals,
+                        h_next
+                    )
+                });
+                Ok(())
+            }
+            Err(e) => {
+                self.state = FmiState::Error;
+                Err(FmiError::error(format!(
+                    "fmi2DoStep from t = {current} to {t_end} failed: {e}; the state stays at t = {current}"
+                )))
+            }
+        }
+    }
+
+    /// fmi2LastSuccessfulTime.
+    pub fn last_successful_time(&self) -> f64 {
+        self.last_successful_time
+    }
+}

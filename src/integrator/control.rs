@@ -1,0 +1,87 @@
+//! Error norm and step-size control of DOPRI5 (Hairer's PI controller, β = 0.04).
+
+/// Tolerances: the error of component i is weighed by atol[i] + rtol·max(|y0_i|, |y1_i|).
+/// Only the first `controlled` components enter the norm (the others are quadratures
+/// carried along, like dissipated energies).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Tolerance<const N: usize> {
+    pub rtol: f64,
+    pub atol: [f64; N],
+    pub controlled: usize,
+}
+
+impl<const N: usize> Tolerance<N> {
+    /// RMS of the weighted local error; ≤ 1 means the step is accurate enough.
+    pub fn norm(&self, y0: &[f64; N], y1: &[f64; N], err: &[f64; N]) -> f64 {
+        let mut sum = 0.0;
+        for i in 0..self.controlled {
+            let scale = self.atol[i] + self.rtol * y0[i].abs().max(y1[i].abs());
+            let e = err[i] / scale;
+            sum += e * e;
+        }
+        (sum / self.controlled as f64).sqrt()
+    }
+}
+
+const SAFETY: f64 = 0.9;
+const BETA: f64 = 0.04;
+const EXPONENT: f64 = 0.2 - BETA * 0.75;
+/// Largest shrink (1/10) and growth (×5) of the step per step.
+const MIN_FACTOR: f64 = 0.1;
+const MAX_FACTOR: f64 = 5.0;
+
+/// Verdict on a step with its weighted error: accept or not, and the next step size.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Verdict {
+    pub accept: bool,
+    pub h_next: f64,
+}
+
+/// PI step-size controller; its memory (the previous error) is part of the solver's state.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Controller {
+    previous_error: f64,
+    rejected_last: bool,
+}
+
+impl Default for Controller {
+    fn default() -> Self {
+        Controller {
+            previous_error: 1e-4,
+            rejected_last: false,
+        }
+    }
+}
+
+impl Controller {
+    pub fn judge(&mut self, err: f64, h: f64) -> Verdict {
+        if !err.is_finite() {
+            self.rejected_last = true;
+            return Verdict {
+                accept: false,
+                h_next: h * MIN_FACTOR,
+            };
+        }
+        let fac11 = err.powf(EXPONENT);
+        if err <= 1.0 {
+            let fac = (fac11 / self.previous_error.powf(BETA) / SAFETY)
+                .clamp(1.0 / MAX_FACTOR, 1.0 / MIN_FACTOR);
+            let mut h_next = h / fac;
+            if self.rejected_last {
+                h_next = h_next.min(h);
+            }
+            self.previous_error = err.max(1e-4);
+            self.rejected_last = false;
+            Verdict {
+                accept: true,
+                h_next,
+            }
+        } else {
+            self.rejected_last = true;
+            Verdict {
+                accept: false,
+                h_next: h / (fac11 / SAFETY).min(1.0 / MIN_FACTOR),
+            }
+        }
+    }
+}

@@ -1,0 +1,143 @@
+//! One step of the Dormand-Prince 5(4) pair (FSAL) with its dense output, after Hairer's
+//! DOPRI5: the 5th-order solution is propagated, the embedded 4th-order one gives the error
+//! estimate, and a continuous extension of order 4 interpolates inside the step.
+
+use super::System;
+
+const C2: f64 = 1.0 / 5.0;
+const C3: f64 = 3.0 / 10.0;
+const C4: f64 = 4.0 / 5.0;
+const C5: f64 = 8.0 / 9.0;
+const A21: f64 = 1.0 / 5.0;
+const A31: f64 = 3.0 / 40.0;
+const A32: f64 = 9.0 / 40.0;
+const A41: f64 = 44.0 / 45.0;
+const A42: f64 = -56.0 / 15.0;
+const A43: f64 = 32.0 / 9.0;
+const A51: f64 = 19372.0 / 6561.0;
+const A52: f64 = -25360.0 / 2187.0;
+const A53: f64 = 64448.0 / 6561.0;
+const A54: f64 = -212.0 / 729.0;
+const A61: f64 = 9017.0 / 3168.0;
+const A62: f64 = -355.0 / 33.0;
+const A63: f64 = 46732.0 / 5247.0;
+const A64: f64 = 49.0 / 176.0;
+const A65: f64 = -5103.0 / 18656.0;
+const A71: f64 = 35.0 / 384.0;
+const A73: f64 = 500.0 / 1113.0;
+const A74: f64 = 125.0 / 192.0;
+const A75: f64 = -2187.0 / 6784.0;
+const A76: f64 = 11.0 / 84.0;
+/// Difference between the 5th- and 4th-order weights.
+const E1: f64 = 71.0 / 57600.0;
+const E3: f64 = -71.0 / 16695.0;
+const E4: f64 = 71.0 / 1920.0;
+const E5: f64 = -17253.0 / 339200.0;
+const E6: f64 = 22.0 / 525.0;
+const E7: f64 = -1.0 / 40.0;
+/// Dense output coefficients.
+const D1: f64 = -12715105075.0 / 11282082432.0;
+const D3: f64 = 87487479700.0 / 32700410799.0;
+const D4: f64 = -10690763975.0 / 1880347072.0;
+const D5: f64 = 701980252875.0 / 199316789632.0;
+const D6: f64 = -1453857185.0 / 822651844.0;
+const D7: f64 = 69997945.0 / 29380423.0;
+
+/// Number of right-hand-side evaluations per step (the 7th is reused as the next k1).
+pub const EVALS_PER_STEP: u64 = 6;
+
+/// A step taken from (t, y0) with size h, not yet accepted.
+pub struct Trial<const N: usize> {
+    pub h: f64,
+    pub y0: [f64; N],
+    pub y1: [f64; N],
+    /// Local error estimate per component.
+    pub err: [f64; N],
+    /// f(t, y0) and the stages needed by the dense output; k7 = f(t + h, y1).
+    k: [[f64; N]; 6],
+}
+
+#[inline]
+fn combine<const N: usize>(y: &[f64; N], h: f64, terms: &[(f64, &[f64; N])]) -> [f64; N] {
+    let mut out = *y;
+    for i in 0..N {
+        let mut acc = 0.0;
+        for (a, k) in terms {
+            acc += a * k[i];
+        }
+        out[i] += h * acc;
+    }
+    out
+}
+
+/// Takes one step of size h from (t, y0), with k1 = f(t, y0) already known.
+pub fn step<S: System<N>, const N: usize>(
+    sys: &S,
+    t: f64,
+    y0: &[f64; N],
+    k1: &[f64; N],
+    h: f64,
+) -> Trial<N> {
+    let k2 = sys.rhs(t + C2 * h, &combine(y0, h, &[(A21, k1)]));
+    let k3 = sys.rhs(t + C3 * h, &combine(y0, h, &[(A31, k1), (A32, &k2)]));
+    let k4 = sys.rhs(
+        t + C4 * h,
+        &combine(y0, h, &[(A41, k1), (A42, &k2), (A43, &k3)]),
+    );
+    let k5 = sys.rhs(
+        t + C5 * h,
+        &combine(y0, h, &[(A51, k1), (A52, &k2), (A53, &k3), (A54, &k4)]),
+    );
+    let k6 = sys.rhs(
+        t + h,
+        &combine(
+            y0,
+            h,
+            &[(A61, k1), (A62, &k2), (A63, &k3), (A64, &k4), (A65, &k5)],
+        ),
+    );
+    let y1 = combine(
+        y0,
+        h,
+        &[(A71, k1), (A73, &k3), (A74, &k4), (A75, &k5), (A76, &k6)],
+    );
+    let k7 = sys.rhs(t + h, &y1);
+    let err = combine(
+        &[0.0; N],
+        h,
+        &[
+            (E1, k1),
+            (E3, &k3),
+            (E4, &k4),
+            (E5, &k5),
+            (E6, &k6),
+            (E7, &k7),
+        ],
+    );
+    Trial {
+        h,
+        y0: *y0,
+        y1,
+        err,
+        k: [*k1, k3, k4, k5, k6, k7],
+    }
+}
+
+impl<const N: usize> Trial<N> {
+    /// f(t + h, y1): the first stage of the next step (FSAL).
+    pub fn k_end(&self) -> &[f64; N] {
+        &self.k[5]
+    }
+
+    /// Component i of the dense output at t + θh, θ ∈ [0, 1].
+    pub fn dense(&self, i: usize, theta: f64) -> f64 {
+        let [k1, k3, k4, k5, k6, k7] = &self.k;
+        let h = self.h;
+        let ydiff = self.y1[i] - self.y0[i];
+        let bspl = h * k1[i] - ydiff;
+        let r4 = ydiff - h * k7[i] - bspl;
+        let r5 = h * (D1 * k1[i] + D3 * k3[i] + D4 * k4[i] + D5 * k5[i] + D6 * k6[i] + D7 * k7[i]);
+        let theta1 = 1.0 - theta;
+        self.y0[i] + theta * (ydiff + theta1 * (bspl + theta * (r4 + theta1 * r5)))
+    }
+}

@@ -1,0 +1,60 @@
+//! Adaptive Runge-Kutta integration of piecewise-smooth ODEs, knowing nothing of gears.
+//!
+//! - [`dopri5`]: the Dormand-Prince 5(4) pair with its 4th-order dense output (Hairer,
+//!   Nørsett & Wanner, *Solving ODEs I*, II.5), one step at a time.
+//! - [`control`]: the error norm (atol + rtol·|y| per component) and the step-size controller.
+//! - [`roots`]: the Illinois root finder used to locate edges on the dense output.
+//! - [`solver`]: the driver that reaches an exact end time, carries the step size over from
+//!   one call to the next, and ends steps exactly on the edges of the system's pieces.
+
+pub mod control;
+pub mod dopri5;
+pub mod roots;
+pub mod solver;
+
+pub use control::Tolerance;
+pub use solver::{Solver, SolverError, Stats};
+
+/// An ODE y' = f(t, y) with N components.
+pub trait System<const N: usize> {
+    fn rhs(&self, t: f64, y: &[f64; N]) -> [f64; N];
+}
+
+/// Which edge of the current piece a trajectory leaves through.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Edge {
+    Lower,
+    Upper,
+}
+
+/// A system whose right-hand side is smooth only piecewise: the current piece is valid while
+/// component `GUARD` stays within `piece()`, and component `RATE` is the time derivative of
+/// `GUARD` (used to find extrema inside a step, so that a grazing crossing is not skipped).
+pub trait Piecewise<const N: usize>: System<N> {
+    const GUARD: usize;
+    const RATE: usize;
+
+    /// The interval [lo, hi] of `y[GUARD]` over which the current piece is valid.
+    fn piece(&self) -> (f64, f64);
+
+    /// Switches to the neighbouring piece through `edge` at time t and state y.
+    fn cross(&mut self, edge: Edge, t: f64, y: &[f64; N]);
+
+    /// Moves to the piece that contains `y[GUARD]` through each edge on the way (after a
+    /// jump of the state from outside the integrator); returns how many edges were crossed.
+    fn settle(&mut self, t: f64, y: &[f64; N]) -> usize {
+        let mut crossed = 0;
+        loop {
+            let (lo, hi) = self.piece();
+            let edge = if y[Self::GUARD] < lo {
+                Edge::Lower
+            } else if y[Self::GUARD] > hi {
+                Edge::Upper
+            } else {
+                return crossed;
+            };
+            self.cross(edge, t, y);
+            crossed += 1;
+        }
+    }
+}

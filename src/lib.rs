@@ -1,0 +1,19 @@
+//! GearRattle: the gear-pair rattle model of Dion, Le Moyne, Chevallier and Sebbah (MSSP
+//! 2009) as an FMI 2.0 Co-Simulation FMU.
+//!
+//! Layers, each knowing nothing of the ones above it:
+//! - [`physics`]: contact law, equation of motion, excitation (MODEL.md);
+//! - [`integrator`]: adaptive DOPRI5 with error control, dense output and edge location;
+//! - [`rattle`]: the gear pair as a piecewise ODE for the integrator, with impact counting;
+//! - [`instance`]: the co-simulation slave (FMI state machine, variables, stepping);
+//! - [`ffi`]: the `fmi2*` C exports on fmi-sys types, one guard around each;
+//! - [`contract`]: value references and the model description, generated from
+//!   `modelDescription/GearRattle.toml`.
+
+pub mod contract;
+pub mod ffi;
+pub mod instance;
+pub mod integrator;
+pub mod packaging;
+pub mod physics;
+pub mod rattle;

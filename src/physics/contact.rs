@@ -1,0 +1,229 @@
+//! Contact law of the tooth pair (MODEL.md §2, the paper's eqs. 5-9 and §6.2).
+//!
+//! The transmission error ξ runs through five regions; inside each, the force is a smooth
+//! (analytic) function of ξ and ξ'. The integrator keeps the region fixed for a whole step
+//! and ends steps on the band edges ξ = −ε, 0, G, G+ε, so no step straddles a kink.
+#![allow(non_snake_case)]
+
+use super::GearParams;
+
+/// Where ξ lies: the regions of MODEL.md §2, from flank F+ (ξ ≤ 0) to flank F− (ξ ≥ G).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Region {
+    /// ξ < −ε: full contact on flank F+ (s = 1).
+    ContactPlus,
+    /// −ε ≤ ξ ≤ 0: entering flank F+ through the smoothing band.
+    BandPlus,
+    /// 0 < ξ < G: free flight in the backlash (s = 0).
+    Gap,
+    /// G ≤ ξ ≤ G + ε: entering flank F− through the smoothing band.
+    BandMinus,
+    /// ξ > G + ε: full contact on flank F− (s = 1).
+    ContactMinus,
+}
+
+impl Region {
+    /// Contact flag of the FMU: 0 gap, 1 flank F+, 2 flank F−.
+    pub fn flank(self) -> i32 {
+        match self {
+            Region::ContactPlus | Region::BandPlus => 1,
+            Region::Gap => 0,
+            Region::BandMinus | Region::ContactMinus => 2,
+        }
+    }
+}
+
+/// The exponent α of the elastic law, with fast paths for the usual contact types.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Power {
+    /// α = 1: linear spring.
+    One,
+    /// α = 4/3 (the paper's value): a cube root instead of a general power.
+    FourThirds,
+    /// α = 3/2 (Hertzian point contact): a square root.
+    ThreeHalves,
+    /// Any other α: |δ/G|^(α−1) through powf.
+    General(f64),
+}
+
+/// Elastic and dissipative parts of the contact force along ξ [N].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ContactForce {
+    /// F_k = s K* δ |δ/G|^(α−1), the paper's K_ξ.
+    pub elastic: f64,
+    /// F_c = s C_LM ξ', the paper's C_ξ.
+    pub dissipative: f64,
+}
+
+impl ContactForce {
+    pub const NONE: ContactForce = ContactForce {
+        elastic: 0.0,
+        dissipative: 0.0,
+    };
+
+    /// F = F_k + F_c.
+    pub fn total(&self) -> f64 {
+        self.elastic + self.dissipative
+    }
+}
+
+/// The contact law of MODEL.md §2 for one set of parameters, with its constants folded.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ContactLaw {
+    K_star: f64,
+    C_LM: f64,
+    G: f64,
+    epsilon: f64,
+    inv_G: f64,
+    /// π / (2ε): s = sin²(π δ / (2ε)) inside a band.
+    half_pi_over_eps: f64,
+    power: Power,
+}
+
+impl ContactLaw {
+    pub fn new(p: &GearParams) -> Self {
+        let power = if p.alpha == 1.0 {
+            Power::One
+        } else if p.alpha == 4.0 / 3.0 {
+            Power::FourThirds
+        } else if p.alpha == 1.5 {
+            Power::ThreeHalves
+        } else {
+            Power::General(p.alpha - 1.0)
+        };
+        ContactLaw {
+            K_star: p.K_star,
+            C_LM: p.C_LM,
+            G: p.G,
+            epsilon: p.epsilon,
+            inv_G: 1.0 / p.G,
+            half_pi_over_eps: std::f64::consts::FRAC_PI_2 / p.epsilon,
+            power,
+        }
+    }
+
+    /// The region that contains ξ (the gap taken closed, [0, G]).
+    pub fn classify(&self, xi: f64) -> Region {
+        let banded = self.epsilon > 0.0;
+        if xi < -self.epsilon {
+            Region::ContactPlus
+        } else if xi < 0.0 {
+            Region::BandPlus
+        } else if xi <= self.G {
+            Region::Gap
+        } else if banded && xi <= self.G + self.epsilon {
+            Region::BandMinus
+        } else {
+            Region::ContactMinus
+        }
+    }
+
+    /// Interval of ξ over which `region`'s formula is the contact law.
+    pub fn bounds(&self, region: Region) -> (f64, f64) {
+        let (e, g) = (self.epsilon, self.G);
+        match region {
+            Region::ContactPlus => (f64::NEG_INFINITY, -e),
+            Region::BandPlus => (-e, 0.0),
+            Region::Gap => (0.0, g),
+            Region::BandMinus => (g, g + e),
+            Region::ContactMinus => (g + e, f64::INFINITY),
+        }
+    }
+
+    /// The region entered when ξ leaves `region` downwards (bands skipped when ε = 0).
+    pub fn below(&self, region: Region) -> Region {
+        let banded = self.epsilon > 0.0;
+        match region {
+            Region::ContactPlus | Region::BandPlus => Region::ContactPlus,
+            Region::Gap if banded => Region::BandPlus,
+            Region::Gap => Region::ContactPlus,
+            Region::BandMinus => Region::Gap,
+            Region::ContactMinus if banded => Region::BandMinus,
+            Region::ContactMinus => Region::Gap,
+        }
+    }
+
+    /// The region entered when ξ leaves `region` upwards (bands skipped when ε = 0).
+    pub fn above(&self, region: Region) -> Region {
+        let banded = self.epsilon > 0.0;
+        match region {
+            Region::ContactPlus if banded => Region::BandPlus,
+            Region::ContactPlus => Region::Gap,
+            Region::BandPlus => Region::Gap,
+            Region::Gap if banded => Region::BandMinus,
+            Region::Gap | Region::BandMinus | Region::ContactMinus => Region::ContactMinus,
+        }
+    }
+
+    /// δ |δ/G|^(α−1), the elastic law without K* and s.
+    #[inline]
+    fn spring(&self, delta: f64) -> f64 {
+        let ratio = delta.abs() * self.inv_G;
+        delta
+            * match self.power {
+                Power::One => 1.0,
+                Power::FourThirds => ratio.cbrt(),
+                Power::ThreeHalves => ratio.sqrt(),
+                Power::General(exponent) => ratio.powf(exponent),
+            }
+    }
+
+    /// Smoothing factor s in a band, as a function of the penetration δ ∈ [−ε, 0] on F+ or
+    /// δ ∈ [0, ε] on F−: s = ½(1 − sin(π/ε (ε/2 ∓ δ))) = sin²(π δ / (2ε)).
+    #[inline]
+    fn smoothing(&self, delta: f64) -> f64 {
+        let s = (self.half_pi_over_eps * delta).sin();
+        s * s
+    }
+
+    /// Contact force for ξ, ξ' with the formula of `region` (MODEL.md §2).
+    #[inline]
+    pub fn force(&self, region: Region, xi: f64, xi_dot: f64) -> ContactForce {
+        let (s, delta) = match region {
+            Region::Gap => return ContactForce::NONE,
+            Region::ContactPlus => (1.0, xi),
+            Region::ContactMinus => (1.0, xi - self.G),
+            Region::BandPlus => (self.smoothing(xi), xi),
+            Region::BandMinus => {
+                let delta = xi - self.G;
+                (self.smoothing(delta), delta)
+            }
+        };
+        ContactForce {
+            elastic: s * self.K_star * self.spring(delta),
+            dissipative: s * self.C_LM * xi_dot,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn classify_is_consistent_with_bounds() {
+        for eps in [0.0, 1e-6] {
+            let law = ContactLaw::new(&GearParams {
+                epsilon: eps,
+                ..GearParams::paper()
+            });
+            for k in -40..=40 {
+                let xi = k as f64 * 1e-6;
+                let r = law.classify(xi);
+                let (lo, hi) = law.bounds(r);
+                assert!(lo <= xi && xi <= hi, "{xi} in {r:?} [{lo}, {hi}]");
+            }
+        }
+    }
+
+    #[test]
+    fn neighbours_skip_empty_bands() {
+        let law = ContactLaw::new(&GearParams {
+            epsilon: 0.0,
+            ..GearParams::paper()
+        });
+        assert_eq!(law.below(Region::Gap), Region::ContactPlus);
+        assert_eq!(law.above(Region::Gap), Region::ContactMinus);
+        assert_eq!(law.above(Region::ContactPlus), Region::Gap);
+    }
+}

@@ -1,0 +1,13 @@
+//! The physics of the gear pair, as restated in `shared/MODEL.md`: parameters (§4), the
+//! contact law (§2), the equation of motion written for the transmission error ξ (§1, §3)
+//! and the excitation of the main shaft (§5). Knows nothing of integrators or FMI.
+
+pub mod contact;
+pub mod excitation;
+pub mod motion;
+pub mod params;
+
+pub use contact::{ContactLaw, Region};
+pub use excitation::{Excitation, Polynomial, Shaft, Sine};
+pub use motion::{Dynamics, Loads};
+pub use params::{GearParams, ParamError};

@@ -1,0 +1,102 @@
+//! The nine parameters of the paper (MODEL.md §4) plus the external torque B and the
+//! carrier-shaft speed ω_S of the equation of motion (§3), with their validation.
+#![allow(non_snake_case)]
+
+/// Parameters of the gear pair, in SI units, named after the paper's symbols.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GearParams {
+    /// Moment of inertia of the loose gear [kg m²].
+    pub I_L: f64,
+    /// Pitch radius of the loose gear [m].
+    pub r_L: f64,
+    /// Pitch radius of the main-shaft gear [m].
+    pub r_M: f64,
+    /// Reduced contact stiffness K* = K_LM G^(α−1) [N/m].
+    pub K_star: f64,
+    /// Contact-type exponent α (10/9 line, 3/2 point contact).
+    pub alpha: f64,
+    /// Width ε of the smoothing band (size of manufacturing errors) [m]; 0 = no band.
+    pub epsilon: f64,
+    /// Backlash on the pitch line G [m].
+    pub G: f64,
+    /// Contact damping C_LM [N s/m].
+    pub C_LM: f64,
+    /// Lubricant viscous coefficient C [N m s].
+    pub C: f64,
+    /// External torque on the loose gear B [N m].
+    pub B: f64,
+    /// Speed of the shaft that carries the loose gear ω_S [rad/s].
+    pub omega_S: f64,
+}
+
+/// A parameter outside its allowed range.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ParamError {
+    pub name: &'static str,
+    pub value: f64,
+    pub allowed: &'static str,
+}
+
+impl std::fmt::Display for ParamError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "parameter {} = {:e} is invalid: allowed {}",
+            self.name, self.value, self.allowed
+        )
+    }
+}
+
+impl GearParams {
+    /// The studied gearbox of the paper (§7), MODEL.md §4.
+    pub fn paper() -> Self {
+        GearParams {
+            I_L: 0.32e-3,
+            r_L: 0.037,
+            r_M: 0.02825,
+            K_star: 3e6,
+            alpha: 4.0 / 3.0,
+            epsilon: 1e-6,
+            G: 25e-6,
+            C_LM: 67.0,
+            C: 0.025,
+            B: 0.0,
+            omega_S: 0.0,
+        }
+    }
+
+    /// Checks every parameter; the first invalid one is reported.
+    pub fn validate(&self) -> Result<(), ParamError> {
+        let positive = "finite and > 0";
+        let non_negative = "finite and >= 0";
+        let checks: [(&'static str, f64, bool, &'static str); 11] = [
+            ("I_L", self.I_L, self.I_L > 0.0, positive),
+            ("r_L", self.r_L, self.r_L > 0.0, positive),
+            ("r_M", self.r_M, self.r_M > 0.0, positive),
+            ("K_star", self.K_star, self.K_star > 0.0, positive),
+            ("alpha", self.alpha, self.alpha >= 1.0, "finite and >= 1"),
+            ("epsilon", self.epsilon, self.epsilon >= 0.0, non_negative),
+            ("G", self.G, self.G > 0.0, positive),
+            ("C_LM", self.C_LM, self.C_LM >= 0.0, non_negative),
+            ("C", self.C, self.C >= 0.0, non_negative),
+            ("B", self.B, true, "finite"),
+            ("omega_S", self.omega_S, true, "finite"),
+        ];
+        match checks
+            .iter()
+            .find(|(_, value, ok, _)| !(value.is_finite() && *ok))
+        {
+            Some(&(name, value, _, allowed)) => Err(ParamError {
+                name,
+                value,
+                allowed,
+            }),
+            None => Ok(()),
+        }
+    }
+
+    /// Angular frequency of ξ in full contact, r_L √(K*/I_L) [rad/s]: the speed scale of ξ'.
+    pub fn contact_frequency(&self) -> f64 {
+        self.r_L * (self.K_star / self.I_L).sqrt()
+    }
+}

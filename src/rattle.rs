@@ -1,0 +1,103 @@
+//! The rattling gear as a piecewise-smooth ODE for the integrator: the state layout, the
+//! right-hand side (MODEL.md §3 plus the dissipated energies and the shaft's work as
+//! quadratures), the region as the current piece, and the impact counters (MODEL.md §1: an
+//! impact is ξ leaving the gap, across 0 downwards on F+ or G upwards on F−).
+#![allow(non_snake_case)]
+
+use crate::integrator::{Edge, Piecewise, System, Tolerance};
+use crate::physics::{Dynamics, Excitation, Region};
+
+/// Components of the state vector.
+pub const XI: usize = 0;
+pub const XI_DOT: usize = 1;
+/// ∫ F_c ξ' dt: energy dissipated in the contact damping [J].
+pub const E_CONTACT: usize = 2;
+/// ∫ C (ω_L − ω_S)² dt: energy dissipated by the lubricant [J].
+pub const E_LUBRICANT: usize = 3;
+/// ∫ −τ_M ω_M dt: work the main shaft feeds into the loose gear [J].
+pub const W_SHAFT: usize = 4;
+pub const N: usize = 5;
+
+pub type State = [f64; N];
+
+/// Impacts counted so far.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Impacts {
+    /// Contact onsets on flank F+ and F−.
+    pub count: [u64; 2],
+    /// |ξ'| at the last onset [m/s].
+    pub last_speed: f64,
+}
+
+/// The gear pair, the region it is in, and what drives the main shaft.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Rattle {
+    pub dynamics: Dynamics,
+    pub region: Region,
+    pub excitation: Excitation,
+    pub impacts: Impacts,
+}
+
+impl Rattle {
+    pub fn new(dynamics: Dynamics, excitation: Excitation, xi: f64) -> Self {
+        Rattle {
+            region: dynamics.law.classify(xi),
+            dynamics,
+            excitation,
+            impacts: Impacts::default(),
+        }
+    }
+
+    /// Error weights: ξ on the scale of G, ξ' on the scale of G times the contact frequency;
+    /// the energies are quadratures outside the error control.
+    pub fn tolerance(&self, rtol: f64) -> Tolerance<N> {
+        let p = &self.dynamics.params;
+        let xi_scale = p.G;
+        let xi_dot_scale = p.G * p.contact_frequency();
+        Tolerance {
+            rtol,
+            atol: [rtol * xi_scale, rtol * xi_dot_scale, 0.0, 0.0, 0.0],
+            controlled: 2,
+        }
+    }
+}
+
+impl System<N> for Rattle {
+    #[inline]
+    fn rhs(&self, t: f64, y: &State) -> State {
+        let shaft = self.excitation.at(t);
+        let loads = self.dynamics.loads(self.region, y[XI], y[XI_DOT], &shaft);
+        let p = &self.dynamics.params;
+        let slip = loads.omega_L - p.omega_S;
+        [
+            y[XI_DOT],
+            loads.xi_ddot,
+            loads.force.dissipative * y[XI_DOT],
+            p.C * slip * slip,
+            -p.r_M * loads.force.total() * shaft.omega,
+        ]
+    }
+}
+
+impl Piecewise<N> for Rattle {
+    const GUARD: usize = XI;
+    const RATE: usize = XI_DOT;
+
+    fn piece(&self) -> (f64, f64) {
+        self.dynamics.law.bounds(self.region)
+    }
+
+    fn cross(&mut self, edge: Edge, _t: f64, y: &State) {
+        let law = &self.dynamics.law;
+        let next = match edge {
+            Edge::Lower => law.below(self.region),
+            Edge::Upper => law.above(self.region),
+        };
+        if self.region == Region::Gap {
+            let flank = if edge == Edge::Lower { 0 } else { 1 };
+            self.impacts.count[flank] += 1;
+            self.impacts.last_speed = y[XI_DOT].abs();
+        }
+        self.region = next;
+    }
+}

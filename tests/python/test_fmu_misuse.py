@@ -1,0 +1,377 @@
+"""Misuse of the FMI 2.0 API: each refused call returns a non-OK status and logs why,
+the process does not crash, and the instance stays usable where that makes sense.
+
+Driven with fmpy's low-level FMU2Slave and a logger callback that records the messages.
+Errors are logged with logging off (the contract: logStatusError is always on)."""
+
+import ctypes
+import math
+
+import pytest
+from fmpy import calloc, free
+from fmpy.fmi1 import FMICallException
+from fmpy.fmi2 import (
+    FMU2Slave,
+    fmi2CallbackAllocateMemoryTYPE,
+    fmi2CallbackFreeMemoryTYPE,
+    fmi2CallbackFunctions,
+    fmi2CallbackLoggerTYPE,
+    fmi2Discard,
+    fmi2Error,
+    fmi2OK,
+    fmi2Real,
+    fmi2String,
+    fmi2ValueReference,
+    fmi2Warning,
+    fmi2Integer,
+)
+
+import reference as R
+
+REFUSED = (fmi2Discard, fmi2Error)  # a refused call: not OK, not Warning, never Fatal
+UNKNOWN_VR = 999
+
+
+class Slave:
+    """An FMU2Slave instance whose log messages are recorded in self.logs."""
+
+    def __init__(self, unzipdir, md, name):
+        self.logs = []  # (status, category, message)
+
+        def logger(env, instance, status, category, message):
+            self.logs.append(
+                (
+                    int(status),
+                    (category or b"").decode("utf-8", "replace"),
+                    (message or b"").decode("utf-8", "replace"),
+                )
+            )
+
+        self._logger = fmi2CallbackLoggerTYPE(logger)  # keep references alive
+        self.callbacks = fmi2CallbackFunctions()
+        self.callbacks.logger = self._logger
+        self.callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
+        self.callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
+        from fmpy.logging import addLoggerProxy  # formats the variadic messages
+
+        addLoggerProxy(ctypes.byref(self.callbacks))
+        self.fmu = FMU2Slave(
+            guid=md.guid,
+            unzipDirectory=unzipdir,
+            modelIdentifier=md.coSimulation.modelIdentifier,
+            instanceName=name,
+        )
+        self.fmu.instantiate(callbacks=self.callbacks, loggingOn=False)
+        self.vrs = {v.name: v.valueReference for v in md.modelVariables}
+        self.t = 0.0
+
+    # --- calls returning the FMI status (fmpy raises above Warning: caught here) --------
+    @staticmethod
+    def _status(fn, *args):
+        try:
+            res = fn(*args)
+        except FMICallException as e:
+            return e.status
+        return res
+
+    def set_real(self, refs, values):
+        n = len(refs)
+        vr = (fmi2ValueReference * n)(*refs)
+        val = (fmi2Real * n)(*values)
+        return self._status(self.fmu.fmi2SetReal, self.fmu.component, vr, n, val)
+
+    def get_real(self, refs):
+        n = len(refs)
+        vr = (fmi2ValueReference * n)(*refs)
+        val = (fmi2Real * n)()
+        return self._status(self.fmu.fmi2GetReal, self.fmu.component, vr, n, val), list(val)
+
+    def set_integer(self, refs, values):
+        n = len(refs)
+        vr = (fmi2ValueReference * n)(*refs)
+        val = (fmi2Integer * n)(*values)
+        return self._status(self.fmu.fmi2SetInteger, self.fmu.component, vr, n, val)
+
+    def get_integer(self, refs):
+        n = len(refs)
+        vr = (fmi2ValueReference * n)(*refs)
+        val = (fmi2Integer * n)()
+        return self._status(self.fmu.fmi2GetInteger, self.fmu.component, vr, n, val), list(val)
+
+    def do_step(self, h, t=None):
+        t = self.t if t is None else t
+        st = self._status(self.fmu.fmi2DoStep, self.fmu.component, t, h, 1)
+        if st in (fmi2OK, fmi2Warning) and h > 0:
+            self.t = t + h
+        return st
+
+    def set_debug_logging(self, on, categories):
+        n = len(categories)
+        cats = (fmi2String * n)(*[c.encode() for c in categories])
+        return self._status(self.fmu.fmi2SetDebugLogging, self.fmu.component, 1 if on else 0, n, cats)
+
+    def setup(self):
+        return self._status(self.fmu.fmi2SetupExperiment, self.fmu.component, 0, 0.0, 0.0, 0, 0.0)
+
+    def enter_init(self):
+        return self._status(self.fmu.fmi2EnterInitializationMode, self.fmu.component)
+
+    def exit_init(self):
+        return self._status(self.fmu.fmi2ExitInitializationMode, self.fmu.component)
+
+    def reset(self):
+        self.t = 0.0
+        return self._status(self.fmu.fmi2Reset, self.fmu.component)
+
+    def terminate(self):
+        return self._status(self.fmu.fmi2Terminate, self.fmu.component)
+
+    def init(self, reals=None, integers=None):
+        """setupExperiment, enter, set start values, exit; all must be OK."""
+        assert self.setup() == fmi2OK
+        assert self.enter_init() == fmi2OK
+        if integers:
+            assert self.set_integer([self.vrs[k] for k in integers], list(integers.values())) == fmi2OK
+        if reals:
+            assert self.set_real([self.vrs[k] for k in reals], list(reals.values())) == fmi2OK
+        assert self.exit_init() == fmi2OK, self.logs[-3:]
+
+    def real(self, name):
+        st, v = self.get_real([self.vrs[name]])
+        assert st == fmi2OK
+        return v[0]
+
+    # --- log inspection ---------------------------------------------------------------
+    def mark(self):
+        return len(self.logs)
+
+    def new_logs(self, mark):
+        return self.logs[mark:]
+
+    def assert_logged(self, mark, *keywords):
+        """A message at Warning or worse since mark, containing every keyword (any case)."""
+        msgs = [m for m in self.new_logs(mark) if m[0] >= fmi2Warning]
+        assert msgs, f"no warning/error message logged (all since mark: {self.new_logs(mark)})"
+        for kw in keywords:
+            assert any(kw.lower() in m[2].lower() for m in msgs), f"no message mentions {kw!r}: {msgs}"
+
+    def free(self):
+        self.fmu.freeInstance()
+
+
+@pytest.fixture
+def slave(unzipdir, model_description):
+    s = Slave(unzipdir, model_description, "misuse")
+    yield s
+    s.free()
+
+
+# ---------------------------------------------------------------------------------------
+
+
+def test_do_step_before_initialization(slave):
+    m = slave.mark()
+    st = slave.do_step(1e-4, t=0.0)
+    assert st in REFUSED
+    slave.assert_logged(m)
+    # the instance can be reset and used
+    assert slave.reset() == fmi2OK
+    slave.init()
+    assert slave.do_step(1e-4) == fmi2OK
+
+
+@pytest.mark.parametrize("when", ["initialization", "step"])
+def test_unknown_value_reference(slave, when):
+    if when == "step":
+        slave.init()
+        assert slave.do_step(1e-4) == fmi2OK
+    else:  # fmi2GetReal is not allowed before initialization mode (FMI 2.0)
+        assert slave.setup() == fmi2OK
+        assert slave.enter_init() == fmi2OK
+    m = slave.mark()
+    st, _ = slave.get_real([UNKNOWN_VR])
+    assert st in REFUSED
+    slave.assert_logged(m, str(UNKNOWN_VR))
+    m = slave.mark()
+    st, _ = slave.get_real([slave.vrs["xi"], UNKNOWN_VR])
+    assert st in REFUSED
+    slave.assert_logged(m, str(UNKNOWN_VR))
+    m = slave.mark()
+    assert slave.set_real([UNKNOWN_VR], [1.0]) in REFUSED
+    slave.assert_logged(m, str(UNKNOWN_VR))
+    # value references are per type: 100 is the Integer `excitation`, 1 the Real `I_L`
+    m = slave.mark()
+    st, _ = slave.get_real([slave.vrs["excitation"]])
+    assert st in REFUSED
+    slave.assert_logged(m)
+    m = slave.mark()
+    st, _ = slave.get_integer([slave.vrs["I_L"]])
+    assert st in REFUSED
+    slave.assert_logged(m)
+    # valid getters still answer
+    st, v = slave.get_real([slave.vrs["I_L"]])
+    assert st == fmi2OK and v[0] == pytest.approx(R.DEFAULTS["I_L"])
+
+
+def test_set_output_refused(slave):
+    slave.init()
+    m = slave.mark()
+    assert slave.set_real([slave.vrs["xi"]], [0.0]) in REFUSED
+    slave.assert_logged(m)
+    assert slave.real("xi") == pytest.approx(0.5 * R.DEFAULTS["G"], abs=1e-18)
+
+
+def test_negative_communication_step(slave):
+    slave.init()
+    assert slave.do_step(1e-4) == fmi2OK
+    m = slave.mark()
+    assert slave.do_step(-1e-4) in REFUSED
+    slave.assert_logged(m)
+    assert slave.real("xi") == pytest.approx(0.5 * R.DEFAULTS["G"], abs=1e-15)
+    # the refused call changed nothing: stepping on from the same time works
+    assert slave.do_step(1e-4) == fmi2OK
+    assert math.isfinite(slave.real("xi"))
+
+
+@pytest.mark.parametrize("bad", [math.nan, math.inf, -math.inf])
+@pytest.mark.parametrize("name", ["theta_M", "omega_M", "alpha_M"])
+def test_non_finite_input_refused(slave, name, bad):
+    slave.init()
+    assert slave.set_real([slave.vrs["omega_M"]], [1.0]) == fmi2OK
+    assert slave.do_step(1e-3) == fmi2OK
+    before = {n: slave.real(n) for n in ("theta_M_out", "omega_M_out", "alpha_M_out", "xi", "xi_dot")}
+    m = slave.mark()
+    assert slave.set_real([slave.vrs[name]], [bad]) in REFUSED
+    slave.assert_logged(m, name)
+    # not applied; the instance goes on
+    after = {n: slave.real(n) for n in before}
+    assert after == before
+    assert slave.do_step(1e-3) == fmi2OK
+    for n in ("xi", "xi_dot", "theta_L", "omega_L", "F_contact", "theta_M_out"):
+        assert math.isfinite(slave.real(n)), n
+    # the shaft's speed is still the last valid input (alpha_M = 0)
+    assert slave.real("omega_M_out") == pytest.approx(1.0, rel=1e-12)
+
+
+INVALID_PARAMETERS = [
+    ("I_L", -1.0),
+    ("I_L", 0.0),
+    ("alpha", 0.5),
+    ("G", 0.0),
+    ("G", -25e-6),
+    ("r_L", 0.0),
+    ("r_M", -0.02),
+    ("K_star", -3e6),
+    ("epsilon", -1e-6),
+    ("C_LM", -1.0),
+    ("C", -0.025),
+    ("I_L", math.nan),
+    ("K_star", math.inf),
+]
+
+
+@pytest.mark.parametrize("name,value", INVALID_PARAMETERS)
+def test_invalid_parameter_refused(slave, name, value):
+    """Refused by setReal or at the latest by exitInitializationMode, with a message naming
+    the parameter; after fmi2Reset a valid initialisation works."""
+    assert slave.setup() == fmi2OK
+    assert slave.enter_init() == fmi2OK
+    m = slave.mark()
+    st_set = slave.set_real([slave.vrs[name]], [value])
+    if st_set == fmi2OK:
+        st_exit = slave.exit_init()
+        assert st_exit in REFUSED, f"{name} = {value} accepted"
+    else:
+        assert st_set in REFUSED
+    slave.assert_logged(m, name)
+    # reset: back to the start values, and a valid run
+    assert slave.reset() == fmi2OK
+    slave.init()
+    assert slave.real(name) == pytest.approx(R.DEFAULTS[name], rel=1e-15)
+    assert slave.do_step(1e-3) == fmi2OK
+    assert slave.real("xi") == pytest.approx(0.5 * R.DEFAULTS["G"], abs=1e-15)
+
+
+@pytest.mark.parametrize(
+    "integers,reals,named",
+    [
+        ({"excitation": 2}, {}, "excitation"),
+        ({"excitation": -1}, {}, "excitation"),
+        ({"excitation": 1}, {"f_exc": 0.0}, "f_exc"),
+    ],
+)
+def test_invalid_excitation_refused(slave, integers, reals, named):
+    assert slave.setup() == fmi2OK
+    assert slave.enter_init() == fmi2OK
+    m = slave.mark()
+    statuses = [slave.set_integer([slave.vrs[k]], [v]) for k, v in integers.items()]
+    statuses += [slave.set_real([slave.vrs[k]], [v]) for k, v in reals.items()]
+    if all(s == fmi2OK for s in statuses):
+        assert slave.exit_init() in REFUSED
+    else:
+        assert any(s in REFUSED for s in statuses)
+    slave.assert_logged(m, named)
+    assert slave.reset() == fmi2OK
+    slave.init(integers={"excitation": 1})
+    assert slave.do_step(1e-3) == fmi2OK
+
+
+def test_unknown_log_category(slave):
+    m = slave.mark()
+    st = slave.set_debug_logging(True, ["noSuchCategory"])
+    assert st in (fmi2Warning, fmi2Discard, fmi2Error)
+    slave.assert_logged(m, "noSuchCategory")
+    # the known categories are accepted; logEvents reports the impacts
+    assert slave.set_debug_logging(True, ["logEvents"]) == fmi2OK
+    slave.init(integers={"excitation": 1})
+    for _ in range(10):  # 10 ms of S1: the first impact is at 6.8 ms (on F+)
+        assert slave.do_step(1e-3) == fmi2OK
+    st, n = slave.get_integer([slave.vrs["impacts_Fplus"]])
+    assert st == fmi2OK and n[0] == 1
+    assert any(cat == "logEvents" for _, cat, _ in slave.logs), slave.logs[-5:]
+    assert slave.set_debug_logging(False, []) == fmi2OK
+
+
+def test_calls_after_terminate(slave):
+    slave.init()
+    assert slave.do_step(1e-3) == fmi2OK
+    assert slave.terminate() == fmi2OK
+    m = slave.mark()
+    assert slave.do_step(1e-3) in REFUSED
+    slave.assert_logged(m)
+    # getters still answer after terminate (FMI 2.0: state "terminated")
+    assert math.isfinite(slave.real("xi"))
+    assert slave.reset() == fmi2OK
+    slave.init()
+    assert slave.do_step(1e-3) == fmi2OK
+
+
+def test_fixed_parameter_not_settable_after_init(slave, model_description):
+    var = next(v for v in model_description.modelVariables if v.name == "I_L")
+    if var.variability == "tunable":
+        pytest.skip("I_L is declared tunable")
+    slave.init()
+    m = slave.mark()
+    assert slave.set_real([slave.vrs["I_L"]], [1e-3]) in REFUSED
+    slave.assert_logged(m, "I_L")
+    assert slave.real("I_L") == pytest.approx(R.DEFAULTS["I_L"])
+    assert slave.do_step(1e-3) == fmi2OK
+
+
+def test_many_instances_in_one_process(unzipdir, model_description):
+    """canBeInstantiatedOnlyOncePerProcess = false: independent instances side by side."""
+    a = Slave(unzipdir, model_description, "a")
+    b = Slave(unzipdir, model_description, "b")
+    try:
+        a.init(integers={"excitation": 1})
+        b.init(integers={"excitation": 1}, reals={"A_rms": 500.0})
+        for _ in range(10):
+            assert a.do_step(1e-3) == fmi2OK
+            assert b.do_step(1e-3) == fmi2OK
+        ra = R.scene("S1", 0.05, 1e-4)
+        rb = R.scene("S3", 0.05, 1e-4)
+        assert a.real("xi") == pytest.approx(ra.xi[100], abs=1e-3 * R.DEFAULTS["G"])
+        assert b.real("xi") == pytest.approx(rb.xi[100], abs=1e-3 * R.DEFAULTS["G"])
+    finally:
+        a.free()
+        b.free()

@@ -1,0 +1,205 @@
+"""The FMU in sine mode (excitation = 1, the paper's bench, MODEL.md §5) against the Python
+reference (reference.py), run through fmpy on target/fmu/GearRattle.fmu."""
+
+import math
+import tomllib
+
+import numpy as np
+import pytest
+
+import reference as R
+from conftest import CONTRACT_PATH
+
+P = R.params()
+G = P["G"]
+DT = 1e-4  # communication step = output interval
+
+
+def _check_times(res, t_end, dt=DT):
+    n = int(round(t_end / dt))
+    assert res["time"].size == n + 1, (res["time"][:3], res["time"][-3:])
+    np.testing.assert_allclose(res["time"], np.arange(n + 1) * dt, rtol=0, atol=1e-12)
+
+
+def fmu_impacts(res):
+    """(flank sequence, index of the output interval of each impact) from the counters."""
+    flanks, ambiguous = R.flanks_from_counters(res["impacts_Fplus"], res["impacts_Fminus"])
+    assert ambiguous == 0, "both impact counters rose within one output interval"
+    dp = np.diff(res["impacts_Fplus"].astype(np.int64), prepend=0)
+    dm = np.diff(res["impacts_Fminus"].astype(np.int64), prepend=0)
+    idx = np.repeat(np.arange(res["time"].size), dp + dm)
+    assert idx.size == flanks.size
+    return flanks, idx
+
+
+def assert_impacts_match(res, ref, slack=1e-7):
+    """Same flank sequence as the reference, each impact inside the FMU's output interval."""
+    flanks, idx = fmu_impacts(res)
+    t = res["time"]
+    ref_sel = ref.impact_t <= t[-1]
+    ref_t, ref_fl = ref.impact_t[ref_sel], ref.impact_flank[ref_sel]
+    assert flanks.tolist() == ref_fl.tolist(), (
+        f"FMU runs {R.runs(flanks)[:12]} ... reference runs {R.runs(ref_fl)[:12]} ...; "
+        f"FMU {flanks.size} impacts, reference {ref_fl.size}"
+    )
+    lo = t[np.maximum(idx - 1, 0)] - slack
+    hi = t[idx] + slack
+    bad = np.nonzero((ref_t < lo) | (ref_t > hi))[0]
+    assert bad.size == 0, f"impact times off: reference {ref_t[bad][:5]}, FMU interval end {t[idx][bad][:5]}"
+
+
+# ---------------------------------------------------------------------------------------
+# The packaged FMU and its model description
+# ---------------------------------------------------------------------------------------
+
+
+def test_validate_fmu(fmu_path):
+    from fmpy.validation import validate_fmu
+
+    problems = validate_fmu(fmu_path)
+    assert problems == [], problems
+
+
+def test_model_description_matches_contract(model_description):
+    """modelDescription.xml carries the contract of modelDescription/GearRattle.toml."""
+    contract = tomllib.loads(CONTRACT_PATH.read_text())
+    md = model_description
+    assert md.fmiVersion == "2.0"
+    assert md.coSimulation is not None and md.coSimulation.modelIdentifier == contract["model"]["identifier"]
+    assert md.modelName == contract["model"]["name"]
+    assert float(md.defaultExperiment.tolerance) == pytest.approx(contract["experiment"]["tolerance"])
+    assert float(md.defaultExperiment.stopTime) == pytest.approx(contract["experiment"]["stopTime"])
+    assert float(md.defaultExperiment.stepSize) == pytest.approx(contract["experiment"]["stepSize"])
+    assert md.coSimulation.canHandleVariableCommunicationStepSize is True
+    by_name = {v.name: v for v in md.modelVariables}
+    assert len(by_name) == len(contract["variable"])
+    for cv in contract["variable"]:
+        v = by_name.get(cv["name"])
+        assert v is not None, f"{cv['name']} missing from modelDescription.xml"
+        assert v.valueReference == cv["vr"], cv["name"]
+        assert v.type == cv["type"], cv["name"]
+        assert v.causality == cv["causality"], cv["name"]
+        if "start" in cv:
+            assert float(v.start) == pytest.approx(cv["start"], rel=1e-15, abs=0), cv["name"]
+        if "unit" in cv:
+            unit = v.unit or (v.declaredType.unit if v.declaredType is not None else None)
+            assert unit == cv["unit"], cv["name"]
+    # ModelStructure: the outputs and their direct dependencies on the inputs
+    # (a missing dependencies attribute, None here, would mean "depends on everything")
+    deps = {u.variable.name: u.dependencies for u in md.outputs}
+    for cv in contract["variable"]:
+        if cv["causality"] == "output":
+            assert cv["name"] in deps, f"{cv['name']} not in ModelStructure/Outputs"
+            assert deps[cv["name"]] is not None, f"{cv['name']}: no dependencies attribute"
+            assert sorted(d.name for d in deps[cv["name"]]) == sorted(cv.get("depends_on", [])), cv["name"]
+    assert [c.name for c in md.logCategories] == [c[0] for c in contract["log_categories"]]
+
+
+def test_default_parameters_are_the_papers(model_description):
+    by_name = {v.name: v for v in model_description.modelVariables}
+    for name, value in R.DEFAULTS.items():
+        assert float(by_name[name].start) == pytest.approx(value, rel=1e-15), name
+
+
+# ---------------------------------------------------------------------------------------
+# Pointwise accuracy over the first 50 ms (all three scenes are predictable there)
+# ---------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("scene", ["S1", "S2", "S3"])
+def test_sine_first_50ms_matches_reference(fmu_run, scene):
+    res = fmu_run("sine", scene, 0.05, DT)
+    ref = R.scene(scene, 0.05, DT)
+    _check_times(res, 0.05)
+    err = np.abs(res["xi"] - ref.xi)
+    k = int(np.argmax(err))
+    assert err[k] <= 1e-4 * G, f"max |dxi| = {err[k] / G:.3e} G at t = {res['time'][k]:.4f} s"
+    err_v = np.max(np.abs(res["xi_dot"] - ref.xi_dot))
+    assert err_v <= 1e-4 * G * 3600, f"max |dxi_dot| = {err_v:.3e} m/s"
+    assert_impacts_match(res, ref)
+    # dissipated energies (quadrature states of the reference)
+    for name in ("E_contact", "E_lubricant"):
+        e_ref = getattr(ref, name)
+        assert e_ref[-1] > 0
+        d = np.max(np.abs(res[name] - e_ref))
+        assert d <= 1e-3 * e_ref[-1], f"{name}: max diff {d:.3e} J, final reference {e_ref[-1]:.3e} J"
+
+
+@pytest.mark.parametrize("scene", ["S1", "S3"])
+def test_sine_outputs_consistent(fmu_run, scene):
+    """The outputs agree with each other, with MODEL.md's formulas and with the excitation."""
+    p = R.params(scene)
+    res = fmu_run("sine", scene, 0.05, DT)
+    t = res["time"]
+    xi, xd = res["xi"], res["xi_dot"]
+    th_m, om_m, al_m = R.main_shaft(t, p)
+    # the built-in excitation (§5)
+    np.testing.assert_allclose(res["theta_M_out"], th_m, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(res["omega_M_out"], om_m, rtol=0, atol=1e-10)
+    np.testing.assert_allclose(res["alpha_M_out"], al_m, rtol=0, atol=1e-8)
+    # kinematics (§1)
+    np.testing.assert_allclose(p["r_L"] * res["theta_L"] - p["r_M"] * res["theta_M_out"], xi, rtol=0, atol=1e-6 * G)
+    np.testing.assert_allclose(p["r_L"] * res["omega_L"] - p["r_M"] * res["omega_M_out"], xd, rtol=0, atol=1e-9)
+    # contact law (§2) and equation of motion (§3)
+    f_law = R.contact_force(xi, xd, p)
+    f_scale = np.max(np.abs(f_law))
+    assert f_scale > 1.0
+    np.testing.assert_allclose(res["F_contact"], f_law, rtol=0, atol=1e-9 * f_scale)
+    np.testing.assert_allclose(res["tau_M"], p["r_M"] * res["F_contact"], rtol=1e-12, atol=1e-15)
+    al_l = (p["B"] - p["r_L"] * res["F_contact"] - p["C"] * (res["omega_L"] - p["omega_S"])) / p["I_L"]
+    np.testing.assert_allclose(res["alpha_L"], al_l, rtol=0, atol=1e-9 * np.max(np.abs(al_l)))
+    np.testing.assert_allclose(res["a_pitch_L"], p["r_L"] * res["alpha_L"], rtol=1e-12, atol=1e-12)
+    # contact flag: 0 gap, 1 F+ (xi < 0), 2 F- (xi > G); points right on an edge not judged
+    clear = (np.abs(xi) > 1e-15) & (np.abs(xi - G) > 1e-15)
+    expected = R.contact_region(xi, p)
+    wrong = np.nonzero(clear & (res["contact"] != expected))[0]
+    assert wrong.size == 0, f"contact flag {res['contact'][wrong][:5]} for xi/G = {xi[wrong][:5] / G}"
+    assert {0, 1, 2} <= set(res["contact"].tolist())
+    # impact speed: |xi_dot| at the last onset, as the reference (held between impacts)
+    ref = R.scene(scene, 0.05, DT)
+    n = res["impacts_Fplus"] + res["impacts_Fminus"]
+    after = n > 0
+    assert np.all(np.isfinite(res["impact_speed"])) and np.all(res["impact_speed"] >= 0.0)
+    assert n[-1] == ref.impact_t.size
+    last = ref.impact_speed[n[after] - 1]
+    np.testing.assert_allclose(res["impact_speed"][after], last, rtol=1e-3, atol=2e-6)
+    # dissipated energies never decrease
+    assert np.all(np.diff(res["E_contact"]) >= 0) and np.all(np.diff(res["E_lubricant"]) >= 0)
+
+
+# ---------------------------------------------------------------------------------------
+# The whole second: impact pattern (S1, S3: pointwise predictable; S2: chaotic)
+# ---------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("scene", ["S1", "S3"])
+def test_sine_1s_impact_pattern(fmu_run, scene):
+    res = fmu_run("sine", scene, 1.0, DT)
+    ref = R.scene(scene, 1.0)
+    _check_times(res, 1.0)
+    assert_impacts_match(res, ref, slack=1e-6)
+    flanks, _ = fmu_impacts(res)
+    assert R.runs_per_flank(flanks) == R.runs_per_flank(ref.impact_flank)
+    # the end state and the dissipated energies
+    assert abs(res["xi"][-1] - ref.final_y[0]) <= 1e-3 * G
+    assert res["E_contact"][-1] == pytest.approx(ref.final_y[2], rel=1e-3)
+    assert res["E_lubricant"][-1] == pytest.approx(ref.final_y[3], rel=1e-3)
+
+
+def test_sine_s2_statistics(fmu_run):
+    """S2 is chaotic beyond ~80 ms: compare impact rates and run lengths over 0.2-1 s."""
+    res = fmu_run("sine", "S2", 1.0, DT)
+    ref = R.scene("S2", 1.0)
+    _check_times(res, 1.0)
+    flanks, idx = fmu_impacts(res)
+    t_imp = res["time"][idx]
+    rt = R.rates(t_imp, flanks, 0.2, 1.0)
+    rr = R.rates(ref.impact_t, ref.impact_flank, 0.2, 1.0)
+    for fl in (R.FPLUS, R.FMINUS):
+        assert rt[fl] == pytest.approx(rr[fl], rel=0.06), (rt, rr)
+    assert sum(rt.values()) == pytest.approx(sum(rr.values()), rel=0.03), (rt, rr)
+    sel = t_imp >= 0.2
+    runs = np.array([n for _, n in R.runs(flanks[sel])])
+    assert set(runs.tolist()) <= {2, 3}, R.runs(flanks[sel])
+    assert 0.02 <= np.mean(runs == 3) <= 0.25, np.bincount(runs)
+    assert math.isfinite(res["E_contact"][-1]) and res["E_contact"][-1] > 0
