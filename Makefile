@@ -18,6 +18,9 @@ TEST_TARGETS := test-rust test-python
 
 all: fmu
 
+# Included before the rules so that the fragments' prerequisites are seen.
+include $(wildcard mk/*.mk)
+
 ## fmu: build target/fmu/GearRattle.fmu (linux64)
 fmu: $(FMU)
 
@@ -61,8 +64,6 @@ libclang:
 		echo "libclang is missing: run 'sudo apt-get install libclang-dev' (or set LIBCLANG_PATH), then retry"; \
 		exit 1; \
 	fi
-
-include $(wildcard mk/*.mk)
 
 clean:
 	cargo clean
