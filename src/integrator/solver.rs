@@ -220,37 +220,40 @@ impl<const N: usize> Solver<N> {
 }
 
 /// Whether the accepted trial leaves [lo, hi] on its guard component, and where: the edge and
-/// the fraction θ of the step at which the dense output first reaches it. A crossing whose
-/// trajectory comes back inside within the step is found through the extremum of the guard
-/// (the zero of its rate), so a grazing contact is not skipped.
+/// the fraction θ of the step at which the dense output first reaches it. The rate of the
+/// guard tells the shape of the trajectory inside the step: moving out then back in (a graze,
+/// decided by the extremum, so it is not skipped), moving in then out (the exit can only come
+/// after the extremum, which matters when the step starts on the edge it just crossed), or
+/// monotone.
 fn locate_edge<S: Piecewise<N>, const N: usize>(
     trial: &Trial<N>,
     lo: f64,
     hi: f64,
 ) -> Option<(Edge, f64)> {
     let (g, r) = (S::GUARD, S::RATE);
-    let rate_root = || illinois(|th| trial.dense(r, th), 0.0, 1.0, 1e-12);
+    let extremum = || illinois(|th| trial.dense(r, th), 0.0, 1.0, 1e-12);
     let find = |edge: Edge, level: f64| -> Option<f64> {
         let outside = |v: f64| match edge {
             Edge::Lower => v < level,
             Edge::Upper => v > level,
         };
-        let turning = match edge {
-            Edge::Lower => trial.y0[r] < 0.0 && trial.y1[r] > 0.0,
-            Edge::Upper => trial.y0[r] > 0.0 && trial.y1[r] < 0.0,
+        let outward = |rate: f64| match edge {
+            Edge::Lower => rate < 0.0,
+            Edge::Upper => rate > 0.0,
         };
-        let end = if outside(trial.y1[g]) {
-            1.0
-        } else if turning {
-            let th = rate_root();
-            if !outside(trial.dense(g, th)) {
-                return None;
+        let (a, b) = match (outward(trial.y0[r]), outward(trial.y1[r])) {
+            (true, false) => {
+                let th = extremum();
+                if !outside(trial.dense(g, th)) {
+                    return None;
+                }
+                (0.0, th)
             }
-            th
-        } else {
-            return None;
+            (false, true) if outside(trial.y1[g]) => (extremum(), 1.0),
+            _ if outside(trial.y1[g]) => (0.0, 1.0),
+            _ => return None,
         };
-        Some(illinois(|th| trial.dense(g, th) - level, 0.0, end, 1e-13))
+        Some(illinois(|th| trial.dense(g, th) - level, a, b, 1e-13))
     };
     let lower = if lo.is_finite() {
         find(Edge::Lower, lo)

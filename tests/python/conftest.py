@@ -72,9 +72,9 @@ def vrs(model_description) -> dict:
     return {v.name: v.valueReference for v in model_description.modelVariables}
 
 
-def main_shaft_input(scene: str, t_end: float, dt: float = 1e-4, fields=("theta_M", "omega_M", "alpha_M")):
+def main_shaft_input(scene: str, t_end: float, dt: float = 1e-4, fields=("theta_M", "omega_M", "alpha_M"), **overrides):
     """Structured input array for fmpy: the analytic sine motion of the main shaft (§5)."""
-    p = R.params(scene)
+    p = R.params(scene, **overrides)
     n = int(round(t_end / dt))
     t = np.arange(n + 1) * dt
     th, om, al = R.main_shaft(t, p)
@@ -88,25 +88,28 @@ def main_shaft_input(scene: str, t_end: float, dt: float = 1e-4, fields=("theta_
 
 @pytest.fixture(scope="session")
 def fmu_run(unzipdir, model_description):
-    """run(mode, scene, t_end, dt, fields=...) -> fmpy result (cached for the session).
+    """run(mode, scene, t_end, dt, fields=..., tol=None, **overrides) -> fmpy result, cached.
 
     mode 'sine': excitation = 1 with the scene's f_exc / A_rms; mode 'inputs': excitation = 0
     (default) driven by the analytic main-shaft motion given as inputs `fields` at dt.
-    The communication step and the output interval are both dt."""
+    The communication step and the output interval are both dt; tol: the relative tolerance
+    (None: the model description's default, 1e-6). overrides: other parameters (start
+    values; in inputs mode omega_mean, f_exc, A_rms shape the input signal instead)."""
     from fmpy import simulate_fmu
 
     cache = {}
 
-    def run(mode: str, scene: str, t_end: float, dt: float = 1e-4, fields=("theta_M", "omega_M", "alpha_M")):
-        key = (mode, scene, t_end, dt, tuple(fields))
+    def run(mode: str, scene: str, t_end: float, dt: float = 1e-4, fields=("theta_M", "omega_M", "alpha_M"), tol=None, **overrides):
+        key = (mode, scene, t_end, dt, tuple(fields), tol, tuple(sorted(overrides.items())))
         if key not in cache:
             sc = R.SCENES[scene]
             if mode == "sine":
-                start = {"excitation": 1, "f_exc": sc["f_exc"], "A_rms": sc["A_rms"]}
+                start = {"excitation": 1, "f_exc": sc["f_exc"], "A_rms": sc["A_rms"], **overrides}
                 inp = None
             elif mode == "inputs":
-                start = {}  # excitation = 0 is the default; f_exc / A_rms unused
-                inp = main_shaft_input(scene, t_end, dt, fields)
+                shaft = {k: overrides.pop(k) for k in ("omega_mean", "f_exc", "A_rms") if k in overrides}
+                start = dict(overrides)  # excitation = 0 is the default
+                inp = main_shaft_input(scene, t_end, dt, fields, **shaft)
             else:
                 raise ValueError(mode)
             cache[key] = simulate_fmu(
@@ -118,6 +121,7 @@ def fmu_run(unzipdir, model_description):
                 input=inp,
                 step_size=dt,
                 output_interval=dt,
+                relative_tolerance=tol,
                 output=OUTPUTS,
             )
         return cache[key]

@@ -165,8 +165,10 @@ def _regions(p: dict):
     return [(0, -inf, 0.0), (2, 0.0, G), (4, G, inf)]
 
 
-def _make_rhs(p: dict, code: int):
-    """Right-hand side with the contact formula of region `code` locked."""
+def _make_rhs(p: dict, code: int, shaft=None):
+    """Right-hand side with the contact formula of region `code` locked.
+
+    shaft: None for the sine excitation of MODEL.md §5, else a function t -> (omega_M, a_M)."""
     I_L, r_L, r_M = p["I_L"], p["r_L"], p["r_M"]
     K, am1, eps, G = p["K_star"], p["alpha"] - 1.0, p["epsilon"], p["G"]
     C_LM, C, B, om_s = p["C_LM"], p["C"], p["B"], p["omega_S"]
@@ -215,9 +217,12 @@ def _make_rhs(p: dict, code: int):
     def rhs(t, y):
         xi = y[0]
         v = y[1]
-        wt = w * t
-        a_m = amp * sin(wt)
-        om_m = om_mean - amp_w * cos(wt)
+        if shaft is None:
+            wt = w * t
+            a_m = amp * sin(wt)
+            om_m = om_mean - amp_w * cos(wt)
+        else:
+            om_m, a_m = shaft(t)
         om_rel = (v + r_M * om_m) / r_L - om_s
         s, f = contact(xi, v)
         dom_l = (B - r_L * f - C * om_rel) / I_L
@@ -239,6 +244,7 @@ class Result:
     impact_t: np.ndarray  # impact (contact onset) times
     impact_flank: np.ndarray  # FPLUS (1) or FMINUS (2)
     impact_speed: np.ndarray  # |xi_dot| at the onset
+    impact_excursion: np.ndarray  # how far into the gap xi went before this onset [m]
     xi_min: float  # extremes of xi over the whole run (step ends and turning points)
     xi_max: float
     nfev: int
@@ -270,22 +276,26 @@ def simulate(
     method: str = "DOP853",
     rtol: float = 1e-12,
     e_scale: float = 1e-3,
+    shaft=None,
+    t_start: float = 0.0,
 ) -> Result:
-    """Integrate the model from t = 0 to t_end with the sine excitation.
+    """Integrate the model from t_start (default 0) to t_end.
 
-    p: full parameter dict (see `params`); t_eval: increasing output times in [0, t_end]
-    (default: none but 0 and t_end); method: 'DOP853' or 'Radau'; rtol: relative tolerance,
+    p: full parameter dict (see `params`); t_eval: increasing output times in [t_start, t_end]
+    (default: t_start and t_end only); method: 'DOP853' or 'Radau'; rtol: relative tolerance,
     the absolute tolerances being rtol * (G, G * 3600 rad/s, e_scale, e_scale).
+    shaft: None for the sine excitation, else a function t -> (omega_M, a_M) (any imposed
+    main-shaft motion); t_start: the initial time (xi = gap_start G, xi_dot = xi_dot_start).
     """
     p = params() if p is None else dict(p)
     G = p["G"]
     solver_cls = _SOLVERS[method]
     atol = rtol * np.array([G, G * 3600.0, e_scale, e_scale])
     if t_eval is None:
-        t_eval = np.array([0.0, t_end])
+        t_eval = np.array([t_start, t_end])
     t_eval = np.asarray(t_eval, dtype=float)
-    if t_eval.size and (t_eval[0] < 0.0 or t_eval[-1] > t_end * (1 + 1e-12) or np.any(np.diff(t_eval) < 0)):
-        raise ValueError("t_eval must be increasing within [0, t_end]")
+    if t_eval.size and (t_eval[0] < t_start or t_eval[-1] > t_end * (1 + 1e-12) or np.any(np.diff(t_eval) < 0)):
+        raise ValueError("t_eval must be increasing within [t_start, t_end]")
     out = np.full((4, t_eval.size), np.nan)
     k_out = 0  # next output index
 
@@ -296,14 +306,14 @@ def simulate(
     xi0 = p["gap_start"] * G
     y = np.array([xi0, p["xi_dot_start"], 0.0, 0.0])
     idx = next(i for i, (_, lo, hi) in enumerate(regions) if lo <= xi0 <= hi)
-    t = 0.0
+    t = t_start
 
-    # outputs at t = 0
-    while k_out < t_eval.size and t_eval[k_out] <= 0.0:
+    # outputs at t_start
+    while k_out < t_eval.size and t_eval[k_out] <= t_start:
         out[:, k_out] = y
         k_out += 1
 
-    imp_t, imp_fl, imp_v = [], [], []
+    imp_t, imp_fl, imp_v, imp_x = [], [], [], []
     xi_min = xi_max = xi0
     nfev = nsteps = npieces = 0
     stalls = 0
@@ -313,8 +323,9 @@ def simulate(
         code, lo, hi = regions[idx]
         rhs = rhs_cache.get(code)
         if rhs is None:
-            rhs = rhs_cache[code] = _make_rhs(p, code)
+            rhs = rhs_cache[code] = _make_rhs(p, code, shaft)
         solver = solver_cls(rhs, t, y, t_end, rtol=rtol, atol=atol)
+        piece_min = piece_max = y[0]  # extremes of xi over this piece
         npieces += 1
         crossing = None  # (t_event, y_event, +1 upper / -1 lower)
         while True:
@@ -342,6 +353,8 @@ def simulate(
                     t_from = t_turn  # xi monotonic on [t_turn, t_new]
                     xi_min = min(xi_min, x_turn)
                     xi_max = max(xi_max, x_turn)
+                    piece_min = min(piece_min, x_turn)
+                    piece_max = max(piece_max, x_turn)
             # crossing of an edge at the step's end
             if tc is None:
                 if x_new < lo:
@@ -359,6 +372,8 @@ def simulate(
                 t_lim = t_new
                 xi_min = min(xi_min, x_new)
                 xi_max = max(xi_max, x_new)
+                piece_min = min(piece_min, x_new)
+                piece_max = max(piece_max, x_new)
             # outputs inside (t_old, t_lim]
             if k_out < t_eval.size and t_eval[k_out] <= t_lim:
                 dense = dense or solver.dense_output()
@@ -384,6 +399,8 @@ def simulate(
             imp_t.append(t)
             imp_fl.append(FPLUS if side < 0 else FMINUS)
             imp_v.append(abs(y[1]))
+            # depth of the excursion into the gap since the last flank: G after a crossing
+            imp_x.append(piece_max - lo if side < 0 else hi - piece_min)
         idx = new_idx
 
     # outputs exactly at t_end that may remain (t_eval[-1] == t_end rounding)
@@ -401,6 +418,7 @@ def simulate(
         impact_t=np.array(imp_t),
         impact_flank=np.array(imp_fl, dtype=int),
         impact_speed=np.array(imp_v),
+        impact_excursion=np.array(imp_x),
         xi_min=xi_min,
         xi_max=xi_max,
         nfev=nfev,

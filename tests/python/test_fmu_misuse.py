@@ -5,11 +5,12 @@ Driven with fmpy's low-level FMU2Slave and a logger callback that records the me
 Errors are logged with logging off (the contract: logStatusError is always on)."""
 
 import ctypes
+import itertools
 import math
 
 import pytest
 from fmpy import calloc, free
-from fmpy.fmi1 import FMICallException
+from fmpy.fmi1 import FMICallException, printLogMessage
 from fmpy.fmi2 import (
     FMU2Slave,
     fmi2CallbackAllocateMemoryTYPE,
@@ -32,24 +33,42 @@ REFUSED = (fmi2Discard, fmi2Error)  # a refused call: not OK, not Warning, never
 UNKNOWN_VR = 999
 
 
+# fmpy's native logger proxy (fmpy.logging.addLoggerProxy: formats the variadic message) keeps
+# ONE process-wide target logger, the last one it was given, and fmpy's default callbacks go
+# through it too. A per-instance Python callback would be left dangling there once its
+# instance is gone (a crash at the next message of any FMU in the process), so a single
+# permanent callback dispatches the messages by instance name.
+_RECORDERS = {}  # instance name -> list of (status, category, message)
+
+
+def _dispatch(env, instance, status, category, message):
+    name = (instance or b"").decode("utf-8", "replace")
+    entry = (
+        int(status),
+        (category or b"").decode("utf-8", "replace"),
+        (message or b"").decode("utf-8", "replace"),
+    )
+    logs = _RECORDERS.get(name)
+    if logs is not None:
+        logs.append(entry)
+    else:
+        printLogMessage(env, instance, status, category, message)
+
+
+_LOGGER = fmi2CallbackLoggerTYPE(_dispatch)
+_instance_count = itertools.count()
+
+
 class Slave:
     """An FMU2Slave instance whose log messages are recorded in self.logs."""
 
     def __init__(self, unzipdir, md, name):
+        name = f"{name}_{next(_instance_count)}"  # unique: the messages are routed by name
+        self.name = name
         self.logs = []  # (status, category, message)
-
-        def logger(env, instance, status, category, message):
-            self.logs.append(
-                (
-                    int(status),
-                    (category or b"").decode("utf-8", "replace"),
-                    (message or b"").decode("utf-8", "replace"),
-                )
-            )
-
-        self._logger = fmi2CallbackLoggerTYPE(logger)  # keep references alive
+        _RECORDERS[name] = self.logs
         self.callbacks = fmi2CallbackFunctions()
-        self.callbacks.logger = self._logger
+        self.callbacks.logger = _LOGGER
         self.callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
         self.callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
         from fmpy.logging import addLoggerProxy  # formats the variadic messages
@@ -157,6 +176,7 @@ class Slave:
 
     def free(self):
         self.fmu.freeInstance()
+        _RECORDERS.pop(self.name, None)
 
 
 @pytest.fixture
@@ -173,7 +193,7 @@ def test_do_step_before_initialization(slave):
     m = slave.mark()
     st = slave.do_step(1e-4, t=0.0)
     assert st in REFUSED
-    slave.assert_logged(m)
+    slave.assert_logged(m, "doStep")
     # the instance can be reset and used
     assert slave.reset() == fmi2OK
     slave.init()
@@ -226,10 +246,24 @@ def test_negative_communication_step(slave):
     assert slave.do_step(1e-4) == fmi2OK
     m = slave.mark()
     assert slave.do_step(-1e-4) in REFUSED
-    slave.assert_logged(m)
+    slave.assert_logged(m, "doStep")
+    m = slave.mark()
+    assert slave.do_step(math.nan) in REFUSED
+    slave.assert_logged(m, "doStep")
     assert slave.real("xi") == pytest.approx(0.5 * R.DEFAULTS["G"], abs=1e-15)
     # the refused call changed nothing: stepping on from the same time works
     assert slave.do_step(1e-4) == fmi2OK
+    assert math.isfinite(slave.real("xi"))
+
+
+def test_communication_point_mismatch(slave):
+    """currentCommunicationPoint must be the instance's time (FMI 2.0: t(k+1) = t(k) + h(k))."""
+    slave.init()
+    assert slave.do_step(1e-3) == fmi2OK
+    m = slave.mark()
+    assert slave.do_step(1e-3, t=0.5) in REFUSED
+    slave.assert_logged(m, "doStep")
+    assert slave.do_step(1e-3) == fmi2OK  # from the right time: goes on
     assert math.isfinite(slave.real("xi"))
 
 

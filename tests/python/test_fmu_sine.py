@@ -1,6 +1,7 @@
 """The FMU in sine mode (excitation = 1, the paper's bench, MODEL.md §5) against the Python
 reference (reference.py), run through fmpy on target/fmu/GearRattle.fmu."""
 
+import functools
 import math
 import tomllib
 
@@ -203,3 +204,189 @@ def test_sine_s2_statistics(fmu_run):
     assert set(runs.tolist()) <= {2, 3}, R.runs(flanks[sel])
     assert 0.02 <= np.mean(runs == 3) <= 0.25, np.bincount(runs)
     assert math.isfinite(res["E_contact"][-1]) and res["E_contact"][-1] > 0
+
+
+# ---------------------------------------------------------------------------------------
+# Every parameter reaches the physics; tolerance; relative coordinates; step sizes
+# ---------------------------------------------------------------------------------------
+
+PARAMETER_SETS = [
+    dict(B=0.01),
+    dict(omega_S=5.0),
+    dict(omega_mean=100.0),  # drag presses the gear on F+ (a driven gear, no rattle)
+    dict(epsilon=0.0),
+    dict(alpha=1.5, K_star=5e6),
+    dict(gap_start=0.2, xi_dot_start=0.01),
+    dict(gap_start=-0.1),  # starts in contact on F+
+    dict(I_L=0.5e-3, r_L=0.04, r_M=0.03),
+    dict(G=50e-6),
+    dict(f_exc=45.0, A_rms=150.0),
+]
+
+
+@pytest.mark.parametrize("overrides", PARAMETER_SETS, ids=lambda d: ",".join(f"{k}={v:g}" for k, v in d.items()))
+def test_sine_parameters_match_reference(fmu_run, overrides):
+    """Off-default parameters (50 ms, default tolerance) against the reference."""
+    p = R.params("S1", **overrides)
+    g = p["G"]
+    res = fmu_run("sine", "S1", 0.05, DT, **overrides)
+    ref = R.simulate(p, 0.05, t_eval=np.arange(501) * DT)
+    _check_times(res, 0.05)
+    err = np.abs(res["xi"] - ref.xi)
+    k = int(np.argmax(err))
+    assert err[k] <= 1e-4 * g, f"max |dxi| = {err[k] / g:.3e} G at t = {res['time'][k]:.4f} s"
+    assert_impacts_match(res, ref)
+    for name in ("E_contact", "E_lubricant"):
+        e_ref = getattr(ref, name)
+        assert np.max(np.abs(res[name] - e_ref)) <= 1e-3 * e_ref[-1] + 1e-15, name
+    np.testing.assert_allclose(p["r_L"] * res["theta_L"] - p["r_M"] * res["theta_M_out"], res["xi"], rtol=0, atol=1e-6 * g)
+    np.testing.assert_allclose(res["F_contact"], R.contact_force(res["xi"], res["xi_dot"], p), rtol=0, atol=1e-9 * max(1.0, np.max(np.abs(res["F_contact"]))))
+
+
+def test_sine_conservative_at_tight_tolerance(fmu_run):
+    """C_LM = C = 0 (no dissipation: errors are not damped), at tolerance 1e-8."""
+    ov = dict(C_LM=0.0, C=0.0)
+    res = fmu_run("sine", "S1", 0.05, DT, tol=1e-8, **ov)
+    ref = R.simulate(R.params("S1", **ov), 0.05, t_eval=np.arange(501) * DT)
+    assert np.max(np.abs(res["xi"] - ref.xi)) <= 1e-4 * G
+    assert_impacts_match(res, ref)
+    assert np.all(res["E_contact"] == 0.0) and np.all(res["E_lubricant"] == 0.0)
+
+
+@pytest.mark.parametrize("tol,bound", [(1e-8, 1e-5), (1e-10, 1e-6)])
+def test_sine_tolerance_is_honoured(fmu_run, tol, bound):
+    """A tighter tolerance (fmi2SetupExperiment) gives a more accurate xi."""
+    res = fmu_run("sine", "S1", 0.05, DT, tol=tol)
+    ref = R.scene("S1", 0.05, DT)
+    err = np.max(np.abs(res["xi"] - ref.xi))
+    assert err <= bound * G, f"tolerance {tol:g}: max |dxi| = {err / G:.2e} G"
+
+
+def test_sine_shaft_at_speed_relative_coordinates(fmu_run):
+    """omega_mean = 1000 rad/s (theta_M reaches 1000 rad in 1 s, r_M theta_M = 28 m) with the
+    carrier shaft at the synchronous speed omega_S = omega_mean r_M / r_L: xi obeys exactly
+    the equations of S1, so the whole second must match S1 (MODEL.md §3: integrate a
+    relative coordinate, not theta_L, or the micrometres are lost to cancellation)."""
+    w = 1000.0
+    ov = dict(omega_mean=w, omega_S=w * P["r_M"] / P["r_L"])
+    res = fmu_run("sine", "S1", 1.0, DT, **ov)
+    ref = R.scene("S1", 1.0)
+    assert res["theta_M_out"][-1] == pytest.approx(w * 1.0, rel=1e-12)
+    assert_impacts_match(res, ref, slack=1e-6)
+    assert abs(res["xi"][-1] - ref.final_y[0]) <= 1e-3 * G
+    assert res["E_contact"][-1] == pytest.approx(ref.final_y[2], rel=1e-3)
+    assert res["E_lubricant"][-1] == pytest.approx(ref.final_y[3], rel=1e-3)
+
+
+def _slave(unzipdir, md, name):
+    from fmpy.fmi2 import FMU2Slave
+
+    fmu = FMU2Slave(
+        guid=md.guid, unzipDirectory=unzipdir, modelIdentifier=md.coSimulation.modelIdentifier, instanceName=name
+    )
+    fmu.instantiate()
+    return fmu
+
+
+def test_sine_communication_steps_do_not_matter(unzipdir, model_description, vrs):
+    """canHandleVariableCommunicationStepSize: irregular steps (7 us to 2.3 ms) and one single
+    50 ms step give the reference's xi and impact counts at the communication points."""
+    rng = np.random.default_rng(20090801)
+    hs = []
+    while sum(hs) < 0.05 - 2.3e-3:
+        hs.append(float(rng.choice([7e-6, 1e-5, 1.3e-4, 3.7e-4, 1e-3, 2.3e-3])))
+    hs.append(0.05 - sum(hs))
+    times = np.concatenate([[0.0], np.cumsum(hs)])
+    ref = R.simulate(R.params("S1"), times[-1], t_eval=times)
+    names = ["xi"]
+    ints = [vrs["impacts_Fplus"], vrs["impacts_Fminus"]]
+
+    fmu = _slave(unzipdir, model_description, "irregular")
+    try:
+        fmu.setupExperiment(startTime=0.0)
+        fmu.enterInitializationMode()
+        fmu.setInteger([vrs["excitation"]], [1])
+        fmu.exitInitializationMode()
+        xi = [fmu.getReal([vrs["xi"]])[0]]
+        counts = [fmu.getInteger(ints)]
+        for t, h in zip(times[:-1], hs):
+            fmu.doStep(currentCommunicationPoint=t, communicationStepSize=h)
+            xi.append(fmu.getReal([vrs[n] for n in names])[0])
+            counts.append(fmu.getInteger(ints))
+        fmu.terminate()
+    finally:
+        fmu.freeInstance()
+    xi = np.array(xi)
+    counts = np.array(counts)
+    assert np.max(np.abs(xi - ref.xi)) <= 1e-4 * G
+    n_plus, n_minus = ref.impact_counts(times)
+    assert counts[:, 0].tolist() == n_plus.tolist()
+    assert counts[:, 1].tolist() == n_minus.tolist()
+
+    fmu = _slave(unzipdir, model_description, "one_step")
+    try:
+        fmu.setupExperiment(startTime=0.0)
+        fmu.enterInitializationMode()
+        fmu.setInteger([vrs["excitation"]], [1])
+        fmu.exitInitializationMode()
+        fmu.doStep(currentCommunicationPoint=0.0, communicationStepSize=times[-1])
+        assert fmu.getReal([vrs["xi"]])[0] == pytest.approx(ref.xi[-1], abs=1e-4 * G)
+        assert fmu.getInteger(ints) == [int(n_plus[-1]), int(n_minus[-1])]
+        fmu.terminate()
+    finally:
+        fmu.freeInstance()
+
+
+# ---------------------------------------------------------------------------------------
+# Robustness: grazing contacts (a flank left and touched again within ~0.1 ms, by a few nm)
+# ---------------------------------------------------------------------------------------
+
+# Configurations of the paper's sweep (30-60 Hz, 100-700 rad/s^2 RMS) whose first 0.1 s
+# contain grazing touches: (f_exc, A_rms, allowed difference of the impact counts)
+GRAZING = [
+    # leaves F- through G at 65.31 ms, 11.7 nm (4.7e-4 G) into the gap, back at 65.41 ms
+    (30.0, 400.0, 0),
+    # leaves F+ through 0 at 78.76 ms by 0.27 nm (1e-5 G, below the accuracy asked of the
+    # FMU: whether it is seen is a matter of luck), back at 78.78 ms
+    (32.0, 500.0, 1),
+]
+
+
+@pytest.mark.parametrize("f_exc,a_rms,slack", GRAZING)
+@pytest.mark.parametrize("h", [1e-3, 1e-4])
+def test_sine_grazing_touches(fmu_run, f_exc, a_rms, slack, h):
+    """Grazing touches are integrated through (no fmi2Error) and counted as the reference does."""
+    ov = dict(f_exc=f_exc, A_rms=a_rms)
+    t_end = 0.1
+    res = fmu_run("sine", "S1", t_end, h, **ov)
+    ref = _ref_cached(f_exc, a_rms, t_end)
+    n_plus, n_minus = ref.impact_counts([t_end])
+    assert abs(int(res["impacts_Fplus"][-1]) - int(n_plus[0])) <= slack, (res["impacts_Fplus"][-1], n_plus[0])
+    assert abs(int(res["impacts_Fminus"][-1]) - int(n_minus[0])) <= slack, (res["impacts_Fminus"][-1], n_minus[0])
+    assert abs(res["xi"][-1] - ref.final_y[0]) <= 1e-3 * G
+
+
+@functools.lru_cache(maxsize=None)
+def _ref_cached(f_exc, a_rms, t_end):
+    return R.simulate(R.params(f_exc=f_exc, A_rms=a_rms), t_end)
+
+
+SWEEP = [(f, a) for f in (30.0, 36.0, 42.0, 48.0, 54.0, 60.0) for a in (100.0, 400.0, 700.0)]
+
+
+def test_sine_paper_sweep_runs_through(fmu_run):
+    """A subset of the paper's sweep, 0.3 s each at a 1 ms communication step: every run
+    completes, rattles on both flanks and stays near the backlash band."""
+    failures = []
+    for f_exc, a_rms in SWEEP:
+        try:
+            res = fmu_run("sine", "S1", 0.3, 1e-3, f_exc=f_exc, A_rms=a_rms)
+        except Exception as e:  # fmpy raises FMICallException on fmi2Error
+            failures.append(f"f_exc={f_exc:g} A_rms={a_rms:g}: {e}")
+            continue
+        xi = res["xi"]
+        if not (res["impacts_Fplus"][-1] > 0 and res["impacts_Fminus"][-1] > 0):
+            failures.append(f"f_exc={f_exc:g} A_rms={a_rms:g}: no rattle")
+        if not (xi.min() > -G and xi.max() < 2 * G):
+            failures.append(f"f_exc={f_exc:g} A_rms={a_rms:g}: xi/G in [{xi.min() / G:.2f}, {xi.max() / G:.2f}]")
+    assert not failures, "\n".join(failures)

@@ -1,0 +1,215 @@
+//! The integrator on problems with known solutions: order of convergence of the DOPRI5 step
+//! and of its dense output, tolerance proportionality, step size carried over between calls,
+//! and edge location (exact crossing times, each crossing counted once, grazes not skipped).
+
+use gear_rattle::integrator::dopri5;
+use gear_rattle::integrator::{Edge, Piecewise, Solver, System, Tolerance};
+
+/// y' = y cos t, y(0) = 1: y = exp(sin t).
+struct Exp;
+
+impl System<1> for Exp {
+    fn rhs(&self, t: f64, y: &[f64; 1]) -> [f64; 1] {
+        [y[0] * t.cos()]
+    }
+}
+
+/// A smooth system seen as one infinite piece.
+impl Piecewise<1> for Exp {
+    const GUARD: usize = 0;
+    const RATE: usize = 0;
+    fn piece(&self) -> (f64, f64) {
+        (f64::NEG_INFINITY, f64::INFINITY)
+    }
+    fn cross(&mut self, _: Edge, _: f64, _: &[f64; 1]) {
+        unreachable!("no edges")
+    }
+}
+
+fn exact(t: f64) -> f64 {
+    t.sin().exp()
+}
+
+/// Errors at t = T (end) and at the middle of the last step (dense), with n fixed steps.
+fn fixed_steps(n: usize) -> (f64, f64) {
+    let t_end = 2.0;
+    let h = t_end / n as f64;
+    let (mut t, mut y) = (0.0, [1.0]);
+    let mut dense_err = 0.0f64;
+    for _ in 0..n {
+        let k1 = Exp.rhs(t, &y);
+        let trial = dopri5::step(&Exp, t, &y, &k1, h);
+        dense_err = dense_err.max((trial.dense(0, 0.5) - exact(t + 0.5 * h)).abs());
+        y = trial.y1;
+        t += h;
+    }
+    ((y[0] - exact(t_end)).abs(), dense_err)
+}
+
+#[test]
+fn the_step_is_fifth_order_and_the_dense_output_fourth() {
+    let mut previous = fixed_steps(10);
+    for n in [20, 40, 80] {
+        let now = fixed_steps(n);
+        let order = (previous.0 / now.0).log2();
+        let dense_order = (previous.1 / now.1).log2();
+        assert!((4.6..5.6).contains(&order), "order {order} at n = {n}");
+        assert!(
+            dense_order > 3.8,
+            "dense output order {dense_order} at n = {n}"
+        );
+        previous = now;
+    }
+}
+
+fn adaptive(rtol: f64, chunks: usize) -> (f64, u64) {
+    let tol = Tolerance {
+        rtol,
+        atol: [rtol],
+        controlled: 1,
+    };
+    let mut solver = Solver::new(tol);
+    let (mut t, mut y) = (0.0, [1.0]);
+    let t_end = 20.0;
+    for k in 1..=chunks {
+        solver
+            .advance(&mut Exp, &mut t, &mut y, t_end * k as f64 / chunks as f64)
+            .unwrap();
+    }
+    assert_eq!(t, t_end);
+    ((y[0] - exact(t_end)).abs(), solver.stats.rhs_evals)
+}
+
+#[test]
+fn the_error_follows_the_tolerance() {
+    let (e6, _) = adaptive(1e-6, 1);
+    let (e9, _) = adaptive(1e-9, 1);
+    assert!(e6 < 1e-4 && e9 < 1e-7, "{e6:e} {e9:e}");
+    assert!(e6 / e9 > 100.0, "1e-6 → {e6:e}, 1e-9 → {e9:e}");
+}
+
+/// Cutting the run into many calls costs at most the extra last steps: the step size and
+/// the controller carry over, nothing restarts.
+#[test]
+fn the_step_size_carries_over_between_calls() {
+    let (e1, one_call) = adaptive(1e-10, 1);
+    let (e100, hundred_calls) = adaptive(1e-10, 100);
+    assert!(
+        (hundred_calls as f64) < 1.3 * one_call as f64 + 6.0 * 100.0,
+        "{hundred_calls} vs {one_call} evaluations"
+    );
+    assert!(e100 < 10.0 * e1.max(1e-12), "{e100:e} vs {e1:e}");
+}
+
+/// x'' = −1 above the edge x = 0 and +1 below it: the exact solution is piecewise
+/// quadratic, crossing 0 at t = (2k+1)√2 from x(0) = 1, x'(0) = 0.
+struct Bounce {
+    below: bool,
+    crossings: Vec<(f64, Edge)>,
+}
+
+impl System<2> for Bounce {
+    fn rhs(&self, _t: f64, y: &[f64; 2]) -> [f64; 2] {
+        [y[1], if self.below { 1.0 } else { -1.0 }]
+    }
+}
+
+impl Piecewise<2> for Bounce {
+    const GUARD: usize = 0;
+    const RATE: usize = 1;
+    fn piece(&self) -> (f64, f64) {
+        if self.below {
+            (f64::NEG_INFINITY, 0.0)
+        } else {
+            (0.0, f64::INFINITY)
+        }
+    }
+    fn cross(&mut self, edge: Edge, t: f64, _: &[f64; 2]) {
+        self.below = edge == Edge::Lower;
+        self.crossings.push((t, edge));
+    }
+}
+
+fn run(sys: &mut Bounce, y0: [f64; 2], t_end: f64, chunks: usize) -> Vec<(f64, Edge)> {
+    let tol = Tolerance {
+        rtol: 1e-8,
+        atol: [1e-8, 1e-8],
+        controlled: 2,
+    };
+    let mut solver = Solver::new(tol);
+    let (mut t, mut y) = (0.0, y0);
+    for k in 1..=chunks {
+        solver
+            .advance(sys, &mut t, &mut y, t_end * k as f64 / chunks as f64)
+            .unwrap();
+    }
+    std::mem::take(&mut sys.crossings)
+}
+
+#[test]
+fn edges_are_located_exactly_and_crossed_once() {
+    for chunks in [1, 7, 1000] {
+        let mut sys = Bounce {
+            below: false,
+            crossings: vec![],
+        };
+        let crossings = run(&mut sys, [1.0, 0.0], 20.0, chunks);
+        let expected: Vec<f64> = (0..7).map(|k| (2 * k + 1) as f64 * 2f64.sqrt()).collect();
+        assert_eq!(crossings.len(), expected.len(), "{crossings:?}");
+        for (k, ((t, edge), want)) in crossings.iter().zip(&expected).enumerate() {
+            assert!(
+                (t - want).abs() < 1e-9,
+                "crossing {k} at {t}, expected {want}"
+            );
+            let down = k % 2 == 0;
+            assert_eq!(*edge, if down { Edge::Lower } else { Edge::Upper });
+        }
+    }
+}
+
+/// A trajectory that dips 10 nm below the edge for 0.3 ms and comes back is caught even
+/// though a single step of the (exact, quadratic) solution could jump over the dip.
+#[test]
+fn a_graze_inside_one_step_is_not_skipped() {
+    struct Graze {
+        crossings: Vec<(f64, Edge)>,
+        below: bool,
+    }
+    impl System<2> for Graze {
+        fn rhs(&self, _t: f64, y: &[f64; 2]) -> [f64; 2] {
+            [y[1], 1.0]
+        }
+    }
+    impl Piecewise<2> for Graze {
+        const GUARD: usize = 0;
+        const RATE: usize = 1;
+        fn piece(&self) -> (f64, f64) {
+            if self.below {
+                (f64::NEG_INFINITY, 0.0)
+            } else {
+                (0.0, f64::INFINITY)
+            }
+        }
+        fn cross(&mut self, edge: Edge, t: f64, _: &[f64; 2]) {
+            self.below = edge == Edge::Lower;
+            self.crossings.push((t, edge));
+        }
+    }
+    // x = 1e-8 − 2e-4 t + t²/2: minimum −1e-8 at t = 2e-4; roots at 2e-4 ∓ √2e-4.
+    let mut sys = Graze {
+        crossings: vec![],
+        below: false,
+    };
+    let tol = Tolerance {
+        rtol: 1e-3,
+        atol: [1.0, 1.0],
+        controlled: 2,
+    };
+    let mut solver = Solver::new(tol);
+    let (mut t, mut y) = (0.0, [1e-8, -2e-4]);
+    solver.advance(&mut sys, &mut t, &mut y, 1.0).unwrap();
+    let roots = [2e-4 - 2f64.sqrt() * 1e-4, 2e-4 + 2f64.sqrt() * 1e-4];
+    assert_eq!(sys.crossings.len(), 2, "{:?}", sys.crossings);
+    assert!((sys.crossings[0].0 - roots[0]).abs() < 1e-9);
+    assert!((sys.crossings[1].0 - roots[1]).abs() < 1e-9);
+}
