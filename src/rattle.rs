@@ -4,6 +4,8 @@
 //! impact is ξ leaving the gap, across 0 downwards on F+ or G upwards on F−).
 #![allow(non_snake_case)]
 
+use serde::{Deserialize, Serialize};
+
 use crate::integrator::{Edge, Piecewise, System, Tolerance};
 use crate::physics::{Dynamics, Excitation, Region};
 
@@ -21,7 +23,7 @@ pub const N: usize = 5;
 pub type State = [f64; N];
 
 /// Impacts counted so far.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Impacts {
     /// Contact onsets on flank F+ and F−.
     pub count: [u64; 2],
@@ -30,7 +32,7 @@ pub struct Impacts {
 }
 
 /// The gear pair, the region it is in, and what drives the main shaft.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Rattle {
     pub dynamics: Dynamics,
     pub region: Region,

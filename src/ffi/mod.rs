@@ -1,14 +1,16 @@
 //! The `fmi2*` C exports on fmi-sys types: each a few lines that unpack C arguments and call
 //! the instance through [`guard::guard`]. Every function of FMI 2.0 Co-Simulation is
-//! exported (importers such as fmpy load all of them by name); the capabilities the model
-//! description does not declare answer fmi2Error with a log line.
+//! exported (importers such as fmpy load all of them by name), and every capability the
+//! model description declares is implemented.
 #![allow(non_snake_case)]
 #![allow(clippy::missing_safety_doc)]
 
+pub mod fmu_state;
 pub mod guard;
 pub mod logger;
 
 use crate::contract::{GUID, MODEL_IDENTIFIER};
+use crate::instance::fmu_state::{deserialize, serialize};
 use crate::instance::{FmiError, FmiResult, Instance, state::allowed};
 use fmi_sys::fmi2::*;
 use guard::{Component, guard, slice, slice_mut};
@@ -365,28 +367,146 @@ pub unsafe extern "C" fn fmi2GetStringStatus(
     })
 }
 
-/// Exports a function of a capability the model description does not declare: it refuses
-/// with fmi2Error and a log line naming the missing capability.
-macro_rules! unsupported {
-    ($name:ident, $capability:literal, ($($arg:ident: $ty:ty),*)) => {
-        #[unsafe(no_mangle)]
-        pub unsafe extern "C" fn $name(c: fmi2Component, $($arg: $ty),*) -> fmi2Status {
-            $(let _ = $arg;)*
-            guard(c, stringify!($name), allowed::UNSUPPORTED, |_| {
-                Err(FmiError::error(concat!(
-                    "not supported: ", $capability, " is false in modelDescription.xml"
-                )))
-            })
-        }
-    };
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2GetFMUstate(c: fmi2Component, state: *mut fmi2FMUstate) -> fmi2Status {
+    guard(c, "fmi2GetFMUstate", allowed::FMU_STATE, |i| {
+        // SAFETY: the importer's slot for a state.
+        unsafe { fmu_state::store(state, i.snapshot()) }
+    })
 }
 
-unsupported!(fmi2GetFMUstate, "canGetAndSetFMUstate", (s: *mut fmi2FMUstate));
-unsupported!(fmi2SetFMUstate, "canGetAndSetFMUstate", (s: fmi2FMUstate));
-unsupported!(fmi2FreeFMUstate, "canGetAndSetFMUstate", (s: *mut fmi2FMUstate));
-unsupported!(fmi2SerializedFMUstateSize, "canSerializeFMUstate", (s: fmi2FMUstate, size: *mut usize));
-unsupported!(fmi2SerializeFMUstate, "canSerializeFMUstate", (s: fmi2FMUstate, bytes: *mut fmi2Byte, size: usize));
-unsupported!(fmi2DeSerializeFMUstate, "canSerializeFMUstate", (bytes: *const fmi2Byte, size: usize, s: *mut fmi2FMUstate));
-unsupported!(fmi2GetDirectionalDerivative, "providesDirectionalDerivative", (vUnknown: *const fmi2ValueReference, nUnknown: usize, vKnown: *const fmi2ValueReference, nKnown: usize, dvKnown: *const fmi2Real, dvUnknown: *mut fmi2Real));
-unsupported!(fmi2SetRealInputDerivatives, "canInterpolateInputs", (vr: *const fmi2ValueReference, nvr: usize, order: *const fmi2Integer, value: *const fmi2Real));
-unsupported!(fmi2GetRealOutputDerivatives, "maxOutputDerivativeOrder > 0", (vr: *const fmi2ValueReference, nvr: usize, order: *const fmi2Integer, value: *mut fmi2Real));
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2SetFMUstate(c: fmi2Component, state: fmi2FMUstate) -> fmi2Status {
+    guard(c, "fmi2SetFMUstate", allowed::FMU_STATE, |i| {
+        // SAFETY: a state fmi2GetFMUstate or fmi2DeSerializeFMUstate returned.
+        let saved = unsafe { fmu_state::get(state) }?;
+        i.restore(&saved.instance);
+        Ok(())
+    })
+}
+
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2FreeFMUstate(c: fmi2Component, state: *mut fmi2FMUstate) -> fmi2Status {
+    // SAFETY: the importer's slot holding one of our states, or NULL.
+    guard(c, "fmi2FreeFMUstate", allowed::FMU_STATE, |_| unsafe {
+        fmu_state::free(state)
+    })
+}
+
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2SerializedFMUstateSize(
+    c: fmi2Component,
+    state: fmi2FMUstate,
+    size: *mut usize,
+) -> fmi2Status {
+    guard(c, "fmi2SerializedFMUstateSize", allowed::FMU_STATE, |_| {
+        // SAFETY: one of our states, and the importer's pointer to one size.
+        let saved = unsafe { fmu_state::get(state) }?;
+        unsafe { slice_mut(size, 1, "size") }?[0] = serialize(&saved.instance).len();
+        Ok(())
+    })
+}
+
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2SerializeFMUstate(
+    c: fmi2Component,
+    state: fmi2FMUstate,
+    bytes: *mut fmi2Byte,
+    size: usize,
+) -> fmi2Status {
+    guard(c, "fmi2SerializeFMUstate", allowed::FMU_STATE, |_| {
+        // SAFETY: one of our states.
+        let data = serialize(&unsafe { fmu_state::get(state) }?.instance);
+        if data.len() != size {
+            return Err(FmiError::error(format!(
+                "size {size} given, the serialized state has {} bytes (fmi2SerializedFMUstateSize)",
+                data.len()
+            )));
+        }
+        // SAFETY: the importer's buffer of `size` bytes.
+        let out = unsafe { slice_mut(bytes as *mut u8, size, "serializedState") }?;
+        out.copy_from_slice(&data);
+        Ok(())
+    })
+}
+
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2DeSerializeFMUstate(
+    c: fmi2Component,
+    bytes: *const fmi2Byte,
+    size: usize,
+    state: *mut fmi2FMUstate,
+) -> fmi2Status {
+    guard(c, "fmi2DeSerializeFMUstate", allowed::FMU_STATE, |_| {
+        // SAFETY: the importer's buffer of `size` bytes, and its slot for a state.
+        let data = unsafe { slice(bytes as *const u8, size, "serializedState") }?;
+        let instance = deserialize(data)?;
+        unsafe { fmu_state::store(state, instance) }
+    })
+}
+
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2GetDirectionalDerivative(
+    c: fmi2Component,
+    vUnknown_ref: *const fmi2ValueReference,
+    nUnknown: usize,
+    vKnown_ref: *const fmi2ValueReference,
+    nKnown: usize,
+    dvKnown: *const fmi2Real,
+    dvUnknown: *mut fmi2Real,
+) -> fmi2Status {
+    guard(c, "fmi2GetDirectionalDerivative", allowed::GET, |i| {
+        // SAFETY: the importer's arrays of nUnknown and nKnown elements.
+        let (unknowns, knowns, dv_known, dv_unknown) = unsafe {
+            (
+                slice(vUnknown_ref, nUnknown, "vUnknown_ref")?,
+                slice(vKnown_ref, nKnown, "vKnown_ref")?,
+                slice(dvKnown, nKnown, "dvKnown")?,
+                slice_mut(dvUnknown, nUnknown, "dvUnknown")?,
+            )
+        };
+        i.directional_derivative(unknowns, knowns, dv_known, dv_unknown)
+    })
+}
+
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2SetRealInputDerivatives(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    nvr: usize,
+    order: *const fmi2Integer,
+    value: *const fmi2Real,
+) -> fmi2Status {
+    guard(c, "fmi2SetRealInputDerivatives", allowed::SET, |i| {
+        // SAFETY: the importer's arrays of nvr elements.
+        let (vr, order, value) = unsafe {
+            (
+                slice(vr, nvr, "vr")?,
+                slice(order, nvr, "order")?,
+                slice(value, nvr, "value")?,
+            )
+        };
+        i.set_input_derivatives(vr, order, value)
+    })
+}
+
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2GetRealOutputDerivatives(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    nvr: usize,
+    order: *const fmi2Integer,
+    value: *mut fmi2Real,
+) -> fmi2Status {
+    guard(c, "fmi2GetRealOutputDerivatives", allowed::GET, |i| {
+        // SAFETY: the importer's arrays of nvr elements.
+        let (vr, order, out) = unsafe {
+            (
+                slice(vr, nvr, "vr")?,
+                slice(order, nvr, "order")?,
+                slice_mut(value, nvr, "value")?,
+            )
+        };
+        i.get_output_derivatives(vr, order, out)
+    })
+}

@@ -4,6 +4,7 @@
 //! [`state::allowed`]; the C layer checks it before calling in.
 
 pub mod error;
+pub mod fmu_state;
 pub mod simulation;
 pub mod state;
 pub mod values;
@@ -14,6 +15,7 @@ pub use state::FmiState;
 
 use crate::contract::{self, Causality, Kind, LOG_CATEGORIES, vr};
 use crate::physics::Shaft;
+use serde::{Deserialize, Serialize};
 use values::Values;
 
 /// A line for the importer's logger.
@@ -29,8 +31,10 @@ const WARNINGS: usize = 1;
 const EVENTS: usize = 2;
 const STEPS: usize = 3;
 
-/// One co-simulation instance.
-#[derive(Clone, Debug)]
+/// One co-simulation instance. Everything but the logging settings and the queued lines is
+/// its FMU state (fmi2GetFMUstate / fmi2SerializeFMUstate): parameters, inputs, time, the
+/// model's state, the integrator's step size and controller memory, counters, energies.
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Instance {
     pub state: FmiState,
     values: Values,
@@ -41,8 +45,10 @@ pub struct Instance {
     sim: Option<Simulation>,
     last_successful_time: f64,
     /// Log categories switched on, in the order of `LOG_CATEGORIES`.
+    #[serde(skip)]
     logging: [bool; LOG_CATEGORIES.len()],
     /// Lines waiting for the importer's logger.
+    #[serde(skip)]
     pub messages: Vec<Message>,
 }
 
@@ -154,12 +160,25 @@ impl Instance {
 
     /// Back to the state after instantiation: start values, no time, no counters.
     pub fn reset(&mut self) -> FmiResult {
+        self.restore(&Instance::new(false));
+        Ok(())
+    }
+
+    /// A copy of the FMU state (no log lines).
+    pub fn snapshot(&self) -> Instance {
+        Instance {
+            messages: Vec::new(),
+            ..self.clone()
+        }
+    }
+
+    /// Takes over a saved FMU state, keeping this instance's logging settings and lines.
+    pub fn restore(&mut self, saved: &Instance) {
         *self = Instance {
             logging: self.logging,
             messages: std::mem::take(&mut self.messages),
-            ..Instance::new(false)
+            ..saved.clone()
         };
-        Ok(())
     }
 
     /// The running simulation, or during initialisation one built from the values so far.
@@ -240,8 +259,17 @@ impl Instance {
             self.values.set_real(*vr, *value);
             shaft_changed |= matches!(*vr, vr::theta_M | vr::omega_M | vr::alpha_M);
         }
+        if shaft_changed || self.state != FmiState::StepComplete {
+            self.inputs_changed();
+        }
+        Ok(())
+    }
+
+    /// After new values: rebuild the initial state during initialisation, or hand the main
+    /// shaft's new motion to the running simulation (inputs take effect at once).
+    fn inputs_changed(&mut self) {
         match self.state {
-            FmiState::StepComplete if shaft_changed => {
+            FmiState::StepComplete => {
                 let shaft = Shaft {
                     theta: self.values.real(vr::theta_M),
                     omega: self.values.real(vr::omega_M),
@@ -250,8 +278,7 @@ impl Instance {
                 let sim = self.sim.as_mut().expect("initialised");
                 let before = sim.rattle.impacts;
                 sim.set_shaft(shaft);
-                let after = sim.rattle.impacts;
-                if before != after {
+                if before != sim.rattle.impacts {
                     self.log(Status::Ok, EVENTS, || {
                         "new inputs moved the gear pair across a contact onset".to_string()
                     });
@@ -259,6 +286,88 @@ impl Instance {
             }
             FmiState::InitializationMode => self.sim = None,
             _ => {}
+        }
+    }
+
+    /// fmi2SetRealInputDerivatives: the derivatives of θ_M (orders 1, 2) and ω_M (order 1) at
+    /// the start of the next step set the speed and acceleration of the main shaft's Taylor
+    /// polynomial over the step (a later call for the same quantity wins).
+    pub fn set_input_derivatives(&mut self, vrs: &[u32], orders: &[i32], values: &[f64]) -> FmiResult {
+        let mut targets = Vec::with_capacity(vrs.len());
+        for ((vr, order), value) in vrs.iter().zip(orders).zip(values) {
+            let target = match (*vr, *order) {
+                (vr::theta_M, 1) => vr::omega_M,
+                (vr::theta_M, 2) | (vr::omega_M, 1) => vr::alpha_M,
+                _ => {
+                    let name = contract::find(Kind::Real, *vr).map_or("?", |v| v.name);
+                    return Err(FmiError::error(format!(
+                        "derivative of order {order} of value reference {vr} ({name}) is not an input derivative of this model: theta_M takes orders 1 and 2, omega_M order 1"
+                    )));
+                }
+            };
+            if !value.is_finite() {
+                return Err(FmiError::error(format!(
+                    "derivative {value} of order {order} refused: values must be finite"
+                )));
+            }
+            targets.push((target, *value));
+        }
+        for (target, value) in targets {
+            self.values.set_real(target, value);
+        }
+        self.inputs_changed();
+        Ok(())
+    }
+
+    /// fmi2GetRealOutputDerivatives (order 1).
+    pub fn get_output_derivatives(&mut self, vrs: &[u32], orders: &[i32], out: &mut [f64]) -> FmiResult {
+        let sim = self.current()?;
+        for ((vr, order), out) in vrs.iter().zip(orders).zip(out) {
+            let var = Self::variable(Kind::Real, *vr)?;
+            *out = match (order, sim.real_output_derivative(*vr)) {
+                (1, Some(d)) => d,
+                _ => {
+                    return Err(FmiError::error(format!(
+                        "no derivative of order {order} for {}: order 1 is given for xi, xi_dot, theta_L, omega_L, F_contact, tau_M, theta_M_out, omega_M_out",
+                        var.name
+                    )));
+                }
+            };
+        }
+        Ok(())
+    }
+
+    /// fmi2GetDirectionalDerivative: dv_unknown = J · dv_known with J = ∂outputs/∂inputs.
+    pub fn directional_derivative(
+        &mut self,
+        unknowns: &[u32],
+        knowns: &[u32],
+        dv_known: &[f64],
+        dv_unknown: &mut [f64],
+    ) -> FmiResult {
+        for k in knowns {
+            let var = Self::variable(Kind::Real, *k)?;
+            if var.causality != Causality::Input {
+                return Err(FmiError::error(format!(
+                    "{} is not an input: directional derivatives are taken with respect to theta_M, omega_M, alpha_M",
+                    var.name
+                )));
+            }
+        }
+        let sim = self.current()?;
+        for (u, out) in unknowns.iter().zip(dv_unknown) {
+            let var = Self::variable(Kind::Real, *u)?;
+            if var.causality != Causality::Output {
+                return Err(FmiError::error(format!(
+                    "{} is not an output: directional derivatives are of outputs",
+                    var.name
+                )));
+            }
+            *out = knowns
+                .iter()
+                .zip(dv_known)
+                .map(|(k, dv)| sim.partial(*u, *k) * dv)
+                .sum();
         }
         Ok(())
     }

@@ -2,6 +2,8 @@
 //! state, and what drives the main shaft. Outputs are computed here when they are read.
 #![allow(non_snake_case)]
 
+use serde::{Deserialize, Serialize};
+
 use super::error::{FmiError, FmiResult};
 use super::values::Values;
 use crate::contract::vr;
@@ -14,7 +16,7 @@ pub const EXCITATION_INPUTS: i64 = 0;
 pub const EXCITATION_SINE: i64 = 1;
 
 /// What moves the main shaft.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub enum Drive {
     /// The paper's bench: exact sine motion, a function of time.
     Sine(Sine),
@@ -24,7 +26,7 @@ pub enum Drive {
 }
 
 /// An initialised gear pair being stepped.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Simulation {
     pub rattle: Rattle,
     pub solver: Solver<{ rattle::N }>,
@@ -179,6 +181,63 @@ impl Simulation {
             vr::alpha_M_out => shaft.alpha,
             _ => return None,
         })
+    }
+
+    /// First time derivative of a Real output (maxOutputDerivativeOrder = 1), from the
+    /// equations of motion at the current state; None where the model has none to give.
+    pub fn real_output_derivative(&self, vr: u32) -> Option<f64> {
+        let dynamics = &self.rattle.dynamics;
+        let p = &dynamics.params;
+        let shaft = self.shaft();
+        let (xi, xi_dot) = (self.y[XI], self.y[XI_DOT]);
+        let loads = dynamics.loads(self.rattle.region, xi, xi_dot, &shaft);
+        let force_rate = || {
+            let slopes = dynamics.law.slopes(self.rattle.region, xi, xi_dot);
+            slopes.d_xi * xi_dot + slopes.d_xi_dot * loads.xi_ddot
+        };
+        Some(match vr {
+            vr::xi => xi_dot,
+            vr::xi_dot => loads.xi_ddot,
+            vr::theta_L => loads.omega_L,
+            vr::omega_L => loads.alpha_L,
+            vr::F_contact => force_rate(),
+            vr::tau_M => p.r_M * force_rate(),
+            vr::theta_M_out => shaft.omega,
+            vr::omega_M_out => shaft.alpha,
+            _ => return None,
+        })
+    }
+
+    /// ∂output/∂input at the current state: how an output read right after new inputs moves
+    /// with them (direct feedthrough; MODEL.md §3 with ξ = r_L θ_L − r_M θ_M at fixed θ_L).
+    /// Zero for inputs the current excitation does not use. ∂τ_M/∂θ_M and ∂τ_M/∂ω_M are the
+    /// coupling stiffness and damping a master sees.
+    pub fn partial(&self, output: u32, input: u32) -> f64 {
+        if !matches!(self.drive, Drive::Inputs(_)) {
+            return 0.0;
+        }
+        let dynamics = &self.rattle.dynamics;
+        let p = &dynamics.params;
+        let slopes = dynamics
+            .law
+            .slopes(self.rattle.region, self.y[XI], self.y[XI_DOT]);
+        // ∂ξ/∂θ_M = −r_M and ∂ξ'/∂ω_M = −r_M; ∂F follows through the contact law.
+        let d_force = match input {
+            vr::theta_M => -p.r_M * slopes.d_xi,
+            vr::omega_M => -p.r_M * slopes.d_xi_dot,
+            _ => 0.0,
+        };
+        match (output, input) {
+            (vr::xi, vr::theta_M) | (vr::xi_dot, vr::omega_M) => -p.r_M,
+            (vr::theta_M_out, vr::theta_M)
+            | (vr::omega_M_out, vr::omega_M)
+            | (vr::alpha_M_out, vr::alpha_M) => 1.0,
+            (vr::F_contact, _) => d_force,
+            (vr::tau_M, _) => p.r_M * d_force,
+            (vr::alpha_L, _) => -p.r_L / p.I_L * d_force,
+            (vr::a_pitch_L, _) => -p.r_L * p.r_L / p.I_L * d_force,
+            _ => 0.0,
+        }
     }
 
     /// The value of an Integer output; None if `vr` is not an Integer output.

@@ -2,7 +2,9 @@
 //! function, in one table, the states in which it may be called (as in the Reference-FMUs).
 //! A call outside them is refused with "illegal call sequence" and not executed.
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+use serde::{Deserialize, Serialize};
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub enum FmiState {
     Instantiated,
     InitializationMode,
@@ -52,7 +54,6 @@ pub mod allowed {
     pub const GET_STATUS: u8 = STEP_COMPLETE | TERMINATED | ERROR;
     /// No asynchronous step is ever pending, so there is never one to cancel.
     pub const CANCEL_STEP: u8 = 0;
-    /// Calls of capabilities this FMU does not declare: reach the instance, which refuses
-    /// them with the reason.
-    pub const UNSUPPORTED: u8 = ANY;
+    /// fmi2Get/Set/Free/(De)SerializeFMUstate: in every state after instantiation.
+    pub const FMU_STATE: u8 = ANY;
 }

@@ -1,9 +1,11 @@
 //! The values of parameters and inputs as last set, indexed by value reference, starting
 //! from the contract's start values.
 
+use serde::{Deserialize, Serialize};
+
 use crate::contract::{Kind, Start, VARIABLES};
 
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Values {
     real: Vec<f64>,
     integer: Vec<i64>,

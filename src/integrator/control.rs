@@ -1,11 +1,14 @@
 //! Error norm and step-size control of DOPRI5 (Hairer's PI controller, β = 0.04).
 
+use serde::{Deserialize, Serialize};
+
 /// Tolerances: the error of component i is weighed by atol[i] + rtol·max(|y0_i|, |y1_i|).
 /// Only the first `controlled` components enter the norm (the others are quadratures
 /// carried along, like dissipated energies).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Tolerance<const N: usize> {
     pub rtol: f64,
+    #[serde(with = "super::serde_array")]
     pub atol: [f64; N],
     pub controlled: usize,
 }
@@ -38,7 +41,7 @@ pub struct Verdict {
 }
 
 /// PI step-size controller; its memory (the previous error) is part of the solver's state.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Controller {
     previous_error: f64,
     rejected_last: bool,

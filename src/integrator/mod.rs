@@ -10,6 +10,7 @@
 pub mod control;
 pub mod dopri5;
 pub mod roots;
+pub mod serde_array;
 pub mod solver;
 
 pub use control::Tolerance;

@@ -6,9 +6,10 @@ use super::control::{Controller, Tolerance};
 use super::dopri5::{self, EVALS_PER_STEP, Trial};
 use super::roots::illinois;
 use super::{Edge, Piecewise};
+use serde::{Deserialize, Serialize};
 
 /// Work counters, as DOPRI5 reports them.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Stats {
     pub rhs_evals: u64,
     pub accepted: u64,
@@ -54,7 +55,7 @@ impl std::fmt::Display for SolverError {
 const MAX_CROSSINGS_AT_ONCE: u32 = 8;
 
 /// Adaptive DOPRI5 with edge location; all of its state is plain data (copyable).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Solver<const N: usize> {
     pub tol: Tolerance<N>,
     /// Most steps one `advance` may take.
@@ -63,8 +64,10 @@ pub struct Solver<const N: usize> {
     /// Step size proposed for the next step (0: not chosen yet).
     h: f64,
     controller: Controller,
-    /// f(t, y) at the current point, when still valid (first stage of the next step).
-    k1: Option<[f64; N]>,
+    /// f(t, y) at the current point (first stage of the next step), when `k1_valid`.
+    #[serde(with = "super::serde_array")]
+    k1: [f64; N],
+    k1_valid: bool,
 }
 
 impl<const N: usize> Solver<N> {
@@ -75,14 +78,15 @@ impl<const N: usize> Solver<N> {
             stats: Stats::default(),
             h: 0.0,
             controller: Controller::default(),
-            k1: None,
+            k1: [0.0; N],
+            k1_valid: false,
         }
     }
 
     /// To be called when the system or the state changed from outside (new inputs, a jump):
     /// the stored derivative no longer holds.
     pub fn invalidate(&mut self) {
-        self.k1 = None;
+        self.k1_valid = false;
     }
 
     /// Step size the next step will try.
@@ -91,15 +95,12 @@ impl<const N: usize> Solver<N> {
     }
 
     fn derivative<S: Piecewise<N>>(&mut self, sys: &S, t: f64, y: &[f64; N]) -> [f64; N] {
-        match self.k1 {
-            Some(k) => k,
-            None => {
-                self.stats.rhs_evals += 1;
-                let k = sys.rhs(t, y);
-                self.k1 = Some(k);
-                k
-            }
+        if !self.k1_valid {
+            self.stats.rhs_evals += 1;
+            self.k1 = sys.rhs(t, y);
+            self.k1_valid = true;
         }
+        self.k1
     }
 
     /// Advances (t, y) to `t_end` exactly.
@@ -114,7 +115,7 @@ impl<const N: usize> Solver<N> {
         let mut crossings_here = 0u32;
         while *t < t_end {
             if sys.settle(*t, y) > 0 {
-                self.k1 = None;
+                self.invalidate();
             }
             let k1 = self.derivative(sys, *t, y);
             if self.h <= 0.0 {
@@ -162,14 +163,15 @@ impl<const N: usize> Solver<N> {
                 y[S::GUARD] = if edge == Edge::Lower { lo } else { hi };
                 sys.cross(edge, *t, y);
                 self.stats.edges += 1;
-                self.k1 = None;
+                self.invalidate();
                 self.h = verdict.h_next.max(theta * h);
                 continue;
             }
             crossings_here = 0;
             *t = if last { t_end } else { *t + h };
             *y = trial.y1;
-            self.k1 = Some(*trial.k_end());
+            self.k1 = *trial.k_end();
+            self.k1_valid = true;
             // A step cut short to land on t_end says little about the natural step size.
             self.h = if last {
                 verdict.h_next.max(self.h)

@@ -5,10 +5,12 @@
 //! and ends steps on the band edges ξ = −ε, 0, G, G+ε, so no step straddles a kink.
 #![allow(non_snake_case)]
 
+use serde::{Deserialize, Serialize};
+
 use super::GearParams;
 
 /// Where ξ lies: the regions of MODEL.md §2, from flank F+ (ξ ≤ 0) to flank F− (ξ ≥ G).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub enum Region {
     /// ξ < −ε: full contact on flank F+ (s = 1).
     ContactPlus,
@@ -34,7 +36,7 @@ impl Region {
 }
 
 /// The exponent α of the elastic law, with fast paths for the usual contact types.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 enum Power {
     /// α = 1: linear spring.
     One,
@@ -68,7 +70,7 @@ impl ContactForce {
 }
 
 /// The contact law of MODEL.md §2 for one set of parameters, with its constants folded.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ContactLaw {
     K_star: f64,
     C_LM: f64,
@@ -168,6 +170,18 @@ impl ContactLaw {
             }
     }
 
+    /// d/dδ of δ |δ/G|^(α−1), which is α |δ/G|^(α−1).
+    #[inline]
+    fn spring_slope(&self, delta: f64) -> f64 {
+        let ratio = delta.abs() * self.inv_G;
+        match self.power {
+            Power::One => 1.0,
+            Power::FourThirds => 4.0 / 3.0 * ratio.cbrt(),
+            Power::ThreeHalves => 1.5 * ratio.sqrt(),
+            Power::General(exponent) => (1.0 + exponent) * ratio.powf(exponent),
+        }
+    }
+
     /// Smoothing factor s in a band, as a function of the penetration δ ∈ [−ε, 0] on F+ or
     /// δ ∈ [0, ε] on F−: s = ½(1 − sin(π/ε (ε/2 ∓ δ))) = sin²(π δ / (2ε)).
     #[inline]
@@ -196,6 +210,40 @@ impl ContactLaw {
     }
 }
 
+/// Partial derivatives of the contact force: ∂F/∂ξ [N/m] and ∂F/∂ξ' [N s/m].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ForceSlopes {
+    pub d_xi: f64,
+    pub d_xi_dot: f64,
+}
+
+impl ContactLaw {
+    /// ∂F/∂ξ and ∂F/∂ξ' with the formula of `region`: the contact's instantaneous stiffness
+    /// and damping along ξ (s' = (π/2ε) sin(π δ/ε) inside a band).
+    pub fn slopes(&self, region: Region, xi: f64, xi_dot: f64) -> ForceSlopes {
+        let (s, ds, delta) = match region {
+            Region::Gap => {
+                return ForceSlopes {
+                    d_xi: 0.0,
+                    d_xi_dot: 0.0,
+                };
+            }
+            Region::ContactPlus => (1.0, 0.0, xi),
+            Region::ContactMinus => (1.0, 0.0, xi - self.G),
+            Region::BandPlus | Region::BandMinus => {
+                let delta = if region == Region::BandPlus { xi } else { xi - self.G };
+                let ds = self.half_pi_over_eps * (2.0 * self.half_pi_over_eps * delta).sin();
+                (self.smoothing(delta), ds, delta)
+            }
+        };
+        let unsmoothed = self.K_star * self.spring(delta) + self.C_LM * xi_dot;
+        ForceSlopes {
+            d_xi: ds * unsmoothed + s * self.K_star * self.spring_slope(delta),
+            d_xi_dot: s * self.C_LM,
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -212,6 +260,28 @@ mod tests {
                 let r = law.classify(xi);
                 let (lo, hi) = law.bounds(r);
                 assert!(lo <= xi && xi <= hi, "{xi} in {r:?} [{lo}, {hi}]");
+            }
+        }
+    }
+
+    /// The analytic slopes match central differences of the force in every region.
+    #[test]
+    fn slopes_match_finite_differences() {
+        for alpha in [1.0, 4.0 / 3.0, 1.5, 10.0 / 9.0] {
+            let p = GearParams {
+                alpha,
+                ..GearParams::paper()
+            };
+            let law = ContactLaw::new(&p);
+            for xi in [-3e-6, -0.7e-6, -0.2e-6, 10e-6, p.G + 0.4e-6, p.G + 3e-6] {
+                let region = law.classify(xi);
+                let (v, h) = (0.02, 1e-12);
+                let f = |x: f64, v: f64| law.force(region, x, v).total();
+                let slopes = law.slopes(region, xi, v);
+                let d_xi = (f(xi + h, v) - f(xi - h, v)) / (2.0 * h);
+                let d_v = (f(xi, v + 1e-6) - f(xi, v - 1e-6)) / 2e-6;
+                assert!((slopes.d_xi - d_xi).abs() <= 1e-4 * d_xi.abs().max(1.0), "{alpha} {xi:e}");
+                assert!((slopes.d_xi_dot - d_v).abs() <= 1e-6 * d_v.abs().max(1.0));
             }
         }
     }

@@ -1,10 +1,12 @@
 //! Motion of the main shaft (MODEL.md §5): the paper's bench sine, or a polynomial
 //! extrapolation of the drivetrain's inputs over a communication step.
 
+use serde::{Deserialize, Serialize};
+
 use std::f64::consts::{PI, SQRT_2};
 
 /// Angle θ_M [rad], speed ω_M [rad/s] and angular acceleration a_M [rad/s²] of the main shaft.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Shaft {
     pub theta: f64,
     pub omega: f64,
@@ -12,7 +14,7 @@ pub struct Shaft {
 }
 
 /// The bench: a_M = A sin(2πf t), A = √2 A_rms, on top of a constant mean speed.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Sine {
     amplitude: f64,
     w: f64,
@@ -42,7 +44,7 @@ impl Sine {
 }
 
 /// Taylor polynomial of the main shaft about t0: θ0 + ω0 τ + α0 τ²/2 (τ = t − t0).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Polynomial {
     pub t0: f64,
     pub at_t0: Shaft,
@@ -62,7 +64,7 @@ impl Polynomial {
 }
 
 /// What drives the main shaft.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub enum Excitation {
     Sine(Sine),
     Polynomial(Polynomial),

@@ -7,7 +7,7 @@ pub mod excitation;
 pub mod motion;
 pub mod params;
 
-pub use contact::{ContactLaw, Region};
+pub use contact::{ContactLaw, ForceSlopes, Region};
 pub use excitation::{Excitation, Polynomial, Shaft, Sine};
 pub use motion::{Dynamics, Loads};
 pub use params::{GearParams, ParamError};

@@ -6,6 +6,8 @@
 //!   ξ'' = r_L ω_L' − r_M a_M
 #![allow(non_snake_case)]
 
+use serde::{Deserialize, Serialize};
+
 use super::{ContactLaw, GearParams, Region, Shaft, contact::ContactForce};
 
 /// Everything the state (ξ, ξ') and the shaft motion determine at one instant.
@@ -22,7 +24,7 @@ pub struct Loads {
 }
 
 /// The gear pair's dynamics for one set of parameters.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Dynamics {
     pub params: GearParams,
     pub law: ContactLaw,

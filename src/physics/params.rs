@@ -2,8 +2,10 @@
 //! carrier-shaft speed ω_S of the equation of motion (§3), with their validation.
 #![allow(non_snake_case)]
 
+use serde::{Deserialize, Serialize};
+
 /// Parameters of the gear pair, in SI units, named after the paper's symbols.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct GearParams {
     /// Moment of inertia of the loose gear [kg m²].
     pub I_L: f64,
