@@ -179,6 +179,9 @@ impl Simulation {
             vr::theta_M_out => shaft.theta,
             vr::omega_M_out => shaft.omega,
             vr::alpha_M_out => shaft.alpha,
+            vr::solver_steps => self.solver.stats.accepted as f64,
+            vr::solver_rejected => self.solver.stats.rejected as f64,
+            vr::solver_rhs => self.solver.stats.rhs_evals as f64,
             _ => return None,
         })
     }
