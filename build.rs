@@ -341,6 +341,12 @@ fn rust(c: &Contract, guid: &str) -> String {
 /// `#[no_mangle]` symbol of its dependencies too (fmi-sys brings `callback_log`). rustc's own
 /// version script names those symbols as global, and GNU ld lets an explicit name win over
 /// our wildcard, so the one fmi-sys brings is named here (a test checks the export table).
+///
+/// Windows (x86_64-pc-windows-gnu): rustc hands GNU ld a .def list of the same symbols, and
+/// ld's PE back end can only add to such a list (a second .def is merged into it;
+/// --exclude-symbols only affects automatic exports), so nothing here can take a name out.
+/// The linker set in .cargo/config.toml, mk/windows-link.sh, links with a copy of rustc's
+/// list narrowed to fmi2*; tests/windows/run.sh checks the DLL's export table.
 fn version_script(out: &std::path::Path) {
     let target_os = env::var("CARGO_CFG_TARGET_OS").unwrap_or_default();
     if target_os != "linux" {

@@ -1,0 +1,52 @@
+# Windows: binaries/win64/GearRattle.dll in the FMU, cross-built with Rust's
+# x86_64-pc-windows-gnu target and MinGW-w64 (linker: mk/windows-link.sh, set in
+# .cargo/config.toml), and tested under Wine against the linux64 binary (tests/windows/run.sh).
+# Installs what it needs when missing: the rustup target, and with apt-get when root
+# gcc-mingw-w64-x86-64 (for `make fmu`) and wine64 (for `make test-windows`).
+
+WIN_TARGET := x86_64-pc-windows-gnu
+WIN_DLL := target/$(WIN_TARGET)/release/gear_rattle.dll
+
+FMU_DEPS += $(WIN_DLL)
+PACKAGE_FLAGS += --win64 $(WIN_DLL)
+TEST_TARGETS += test-windows
+
+.PHONY: windows-toolchain windows-wine test-windows
+
+# fmi-sys's bindgen parses the FMI headers for the Windows target against MinGW's headers,
+# whose malloc.h needs clang's own include directory (mm_malloc.h) first.
+$(WIN_DLL): FORCE | libclang windows-toolchain
+	@mm_malloc=$$(ls /usr/lib/llvm-*/lib/clang/*/include/mm_malloc.h 2>/dev/null | sort -V | tail -n 1); \
+	[ -n "$$mm_malloc" ] || { echo "clang's mm_malloc.h not found (libclang-dev installs it)"; exit 1; }; \
+	export BINDGEN_EXTRA_CLANG_ARGS_x86_64_pc_windows_gnu="-I$$(dirname "$$mm_malloc")"; \
+	echo "BINDGEN_EXTRA_CLANG_ARGS_x86_64_pc_windows_gnu=$$BINDGEN_EXTRA_CLANG_ARGS_x86_64_pc_windows_gnu"; \
+	echo "cargo build --release --lib --target $(WIN_TARGET)"; \
+	cargo build --release --lib --target $(WIN_TARGET)
+
+## test-windows: the win64 DLL under Wine agrees with the linux64 .so; its export/import tables
+test-windows: fmu | windows-toolchain windows-wine
+	tests/windows/run.sh $(FMU)
+
+# $(1): a Debian package, $(2): a shell test that succeeds when it is installed.
+# Installs it with apt-get when root, else says how and stops.
+define apt_install
+	@if $(2); then :; \
+	elif [ "$$(id -u)" = 0 ]; then \
+		echo "$(1) missing: installing it with apt-get"; \
+		apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends $(1) >/dev/null; \
+	else \
+		echo "$(1) is missing: run 'sudo apt-get install $(1)', then retry"; \
+		exit 1; \
+	fi
+endef
+
+windows-toolchain:
+	@rustup target list --installed | grep -qx $(WIN_TARGET) || { \
+		echo "Rust target $(WIN_TARGET) missing: rustup target add $(WIN_TARGET)"; \
+		rustup target add $(WIN_TARGET); }
+	$(call apt_install,gcc-mingw-w64-x86-64,command -v x86_64-w64-mingw32-gcc >/dev/null)
+
+# Debian's wine64 puts its loader in /usr/lib/wine (/usr/bin/wine comes with `wine`, which
+# would also pull 32-bit parts the test does not need).
+windows-wine:
+	$(call apt_install,wine64,command -v wine64 >/dev/null || [ -x /usr/lib/wine/wine64 ])
