@@ -130,3 +130,145 @@ def per_period_counts(events, f_exc, t_from, t_to, t_start=0.0):
 def values_at_impacts(events, values):
     """A sampled output (e.g. impact_speed) read at the sample right after each impact."""
     return np.asarray(values)[events["index"]]
+
+
+# --------------------------------------------------------------------------- window summaries
+# (added for scripts/rattle_map.py; the functions above are unchanged)
+
+def mean_rate(t, y, t_from, t_to):
+    """Mean rate of a cumulative output y (e.g. a dissipated energy) over [t_from, t_to]:
+    (y(t_to) - y(t_from)) / (t_to - t_from), y linearly interpolated between samples."""
+    t = np.asarray(t, dtype=float)
+    y = np.asarray(y, dtype=float)
+    if t_to <= t_from:
+        return float("nan")
+    return float((np.interp(t_to, t, y) - np.interp(t_from, t, y)) / (t_to - t_from))
+
+
+def min_gap_same_flank(events, t_from=0.0):
+    """Shortest time between two consecutive impacts on the same flank (inside a run) among
+    the impacts after t_from; nan when there is no such pair. Resolution: the output interval."""
+    tm, fl = events["time"], events["flank"]
+    sel = tm > t_from
+    tm, fl = tm[sel], fl[sel]
+    same = fl[1:] == fl[:-1]
+    if not np.any(same):
+        return float("nan")
+    return float(np.min(np.diff(tm)[same]))
+
+
+def decreasing_runs(events, speeds, t_from=0.0):
+    """Among the complete runs (see complete_runs) of at least 2 impacts starting at or after
+    t_from: (number of runs whose impact speeds strictly decrease along the run, number of
+    runs). speeds: one value per impact (values_at_impacts)."""
+    r = runs(events["flank"])
+    speeds = np.asarray(speeds, dtype=float)
+    n = dec = 0
+    for k, (_, length, s) in enumerate(r[:-1]):  # the last run may be cut by the record's end
+        if length < 2 or events["time"][s] < t_from:
+            continue
+        n += 1
+        dec += bool(np.all(np.diff(speeds[s:s + length]) < 0))
+    return dec, n
+
+
+def free_flights(t, contact, t_from=0.0):
+    """Free flights (contact == 0) that start after t_from and end before the record does:
+    a list of (first, last + 1) sample-index pairs."""
+    t = np.asarray(t, dtype=float)
+    gap = np.asarray(contact) == 0
+    edges = np.diff(np.concatenate(([0], gap.astype(np.int8), [0])))
+    starts, ends = np.nonzero(edges == 1)[0], np.nonzero(edges == -1)[0]
+    return [(int(s), int(e)) for s, e in zip(starts, ends)
+            if s > 0 and e < len(t) and t[s] > t_from]
+
+
+def free_flight_decay(t, omega, contact, t_from=0.0, min_duration=1e-3):
+    """Decay rates of the loose-gear speed during free flights (contact == 0).
+
+    For each free flight (see free_flights) lasting at least min_duration in which omega keeps
+    one sign, the least-squares slope of -ln|omega| against time (1/s). With the lubricant drag
+    alone (B = 0, omega_S = 0) every rate is C* = C / I_L. Returns an array, one rate per flight.
+    """
+    t = np.asarray(t, dtype=float)
+    omega = np.asarray(omega, dtype=float)
+    rates = []
+    for s, e in free_flights(t, contact, t_from):
+        # leave out the samples next to the contacts (the contact may end inside them)
+        s, e = s + 1, e - 1
+        if e - s < 3 or t[e - 1] - t[s] < min_duration:
+            continue
+        w = omega[s:e]
+        if np.any(w == 0) or not (np.all(w > 0) or np.all(w < 0)):
+            continue
+        rates.append(-np.polyfit(t[s:e], np.log(np.abs(w)), 1)[0])
+    return np.asarray(rates)
+
+
+def rattle_summary(t, n_plus, n_minus, f_exc, t_from, t_to=None, impact_speed=None,
+                   energies=(), accel=None):
+    """The statistics of one steady window [t_from, t_to] (default: to the end of the record),
+    as a flat dict of numbers (nan where undefined), for tables and maps:
+
+      periods, impacts_Fplus, impacts_Fminus     whole periods and impacts in the window
+      impacts_per_period (+ _Fplus, _Fminus)     mean over the whole periods
+      mean_run (+ _Fplus, _Fminus), runs         consecutive impacts on one flank (complete
+      run_min, run_max, run_lengths              runs, see complete_runs); run_lengths is
+                                                 {length: count}
+      mean_impact_speed, max_impact_speed        m/s (if impact_speed is given), and
+      mean_impact_speed_Fplus, _Fminus           per flank
+      runs_decreasing                            fraction of the complete runs of >= 2 impacts
+                                                 whose impact speeds decrease along the run
+      min_gap_same_flank                         s, see min_gap_same_flank
+      power_<name>                               W: mean_rate of each cumulative energy in
+                                                 energies, a sequence of (name, values)
+      rms_accel                                  RMS of accel over the window (if given)
+      ambiguous                                  see impact_events
+    """
+    t = np.asarray(t, dtype=float)
+    if t_to is None:
+        t_to = float(t[-1])
+    ev = impact_events(t, n_plus, n_minus)
+    out = {"ambiguous": ev["ambiguous"]}
+    pf = impacts_per_flank(ev, t_from, t_to)
+    out["impacts_Fplus"], out["impacts_Fminus"] = pf[FPLUS][0], pf[FMINUS][0]
+    k, pp = per_period_counts(ev, f_exc, t_from, t_to)
+    out["periods"] = len(k)
+    nan = float("nan")
+    if len(k):
+        out["impacts_per_period_Fplus"] = float(pp[:, 0].mean())
+        out["impacts_per_period_Fminus"] = float(pp[:, 1].mean())
+        out["impacts_per_period"] = float(pp.sum(axis=1).mean())
+    else:
+        out["impacts_per_period_Fplus"] = out["impacts_per_period_Fminus"] = nan
+        out["impacts_per_period"] = nan
+    cr = [r for r in complete_runs(ev, t_from) if r[2] <= t_to]
+    lengths = np.array([n for _, n, _ in cr], dtype=float)
+    out["runs"] = len(cr)
+    out["mean_run"] = float(lengths.mean()) if len(cr) else nan
+    for fl, name in ((FPLUS, "Fplus"), (FMINUS, "Fminus")):
+        ln = [n for f_, n, _ in cr if f_ == fl]
+        out["mean_run_" + name] = float(np.mean(ln)) if ln else nan
+    out["run_min"] = float(lengths.min()) if len(cr) else nan
+    out["run_max"] = float(lengths.max()) if len(cr) else nan
+    out["run_lengths"] = run_length_distribution(cr)
+    win = (ev["time"] > t_from) & (ev["time"] <= t_to)
+    if impact_speed is not None:
+        v = values_at_impacts(ev, impact_speed)[win]
+        out["mean_impact_speed"] = float(v.mean()) if len(v) else nan
+        out["max_impact_speed"] = float(v.max()) if len(v) else nan
+        vv = values_at_impacts(ev, impact_speed)
+        dec, n = decreasing_runs(ev, vv, t_from)
+        out["runs_decreasing"] = dec / n if n else nan
+        for fl, name in ((FPLUS, "Fplus"), (FMINUS, "Fminus")):
+            v = vv[win & (ev["flank"] == fl)]
+            out["mean_impact_speed_" + name] = float(v.mean()) if len(v) else nan
+    sub = {"time": ev["time"][win], "flank": ev["flank"][win]}
+    out["min_gap_same_flank"] = min_gap_same_flank(sub)
+    for name, e in energies:
+        out["power_" + name] = mean_rate(t, e, t_from, t_to)
+    if accel is not None:
+        sel = (t >= t_from) & (t <= t_to)
+        a = np.asarray(accel, dtype=float)[sel]
+        out["rms_accel"] = float(np.sqrt(np.mean(a ** 2))) if len(a) else nan
+    return out
