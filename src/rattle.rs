@@ -50,12 +50,16 @@ impl Rattle {
         }
     }
 
-    /// Error weights: ξ on the scale of G, ξ' on the scale of G times the contact frequency;
-    /// the energies are quadratures outside the error control.
+    /// Error weights: ξ on the scale of G; ξ' relative to itself, with a floor of G per
+    /// millisecond (or G times the contact frequency, if lower). An error δ in ξ' moves ξ by
+    /// δ·G/|ξ'| over a flight across the gap, so ξ' must be held to rtol·|ξ'|, not to the
+    /// contact's speed scale: with hard contacts (K* = 1e10) that looser floor let ξ drift by
+    /// 100 rtol per flight. The energies are quadratures outside the error control.
     pub fn tolerance(&self, rtol: f64) -> Tolerance<N> {
+        const FLIGHT_RATE: f64 = 1e3;
         let p = &self.dynamics.params;
         let xi_scale = p.G;
-        let xi_dot_scale = p.G * p.contact_frequency();
+        let xi_dot_scale = p.G * p.contact_frequency().min(FLIGHT_RATE);
         Tolerance {
             rtol,
             atol: [rtol * xi_scale, rtol * xi_dot_scale, 0.0, 0.0, 0.0],

@@ -386,7 +386,10 @@ pub unsafe extern "C" fn fmi2SetFMUstate(c: fmi2Component, state: fmi2FMUstate) 
 }
 
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2FreeFMUstate(c: fmi2Component, state: *mut fmi2FMUstate) -> fmi2Status {
+pub unsafe extern "C" fn fmi2FreeFMUstate(
+    c: fmi2Component,
+    state: *mut fmi2FMUstate,
+) -> fmi2Status {
     // SAFETY: the importer's slot holding one of our states, or NULL.
     guard(c, "fmi2FreeFMUstate", allowed::FMU_STATE, |_| unsafe {
         fmu_state::free(state)

@@ -78,7 +78,8 @@ mod tests {
 
     fn stepped() -> Instance {
         let mut i = Instance::new(false);
-        i.set_integer(&[crate::contract::vr::excitation], &[1]).unwrap();
+        i.set_integer(&[crate::contract::vr::excitation], &[1])
+            .unwrap();
         i.enter_initialization_mode().unwrap();
         i.exit_initialization_mode().unwrap();
         i.do_step(0.0, 0.01).unwrap();
@@ -97,11 +98,21 @@ mod tests {
         let bytes = serialize(&stepped());
         let mut flipped = bytes.clone();
         flipped[HEADER + 3] ^= 1;
-        assert!(deserialize(&flipped).unwrap_err().message.contains("checksum"));
+        assert!(
+            deserialize(&flipped)
+                .unwrap_err()
+                .message
+                .contains("checksum")
+        );
         assert!(deserialize(&bytes[..bytes.len() - 1]).is_err());
         assert!(deserialize(b"hello world, not a state").is_err());
         let mut version = bytes.clone();
         version[4] = 9;
-        assert!(deserialize(&version).unwrap_err().message.contains("version"));
+        assert!(
+            deserialize(&version)
+                .unwrap_err()
+                .message
+                .contains("version")
+        );
     }
 }

@@ -292,7 +292,12 @@ impl Instance {
     /// fmi2SetRealInputDerivatives: the derivatives of θ_M (orders 1, 2) and ω_M (order 1) at
     /// the start of the next step set the speed and acceleration of the main shaft's Taylor
     /// polynomial over the step (a later call for the same quantity wins).
-    pub fn set_input_derivatives(&mut self, vrs: &[u32], orders: &[i32], values: &[f64]) -> FmiResult {
+    pub fn set_input_derivatives(
+        &mut self,
+        vrs: &[u32],
+        orders: &[i32],
+        values: &[f64],
+    ) -> FmiResult {
         let mut targets = Vec::with_capacity(vrs.len());
         for ((vr, order), value) in vrs.iter().zip(orders).zip(values) {
             let target = match (*vr, *order) {
@@ -320,7 +325,12 @@ impl Instance {
     }
 
     /// fmi2GetRealOutputDerivatives (order 1).
-    pub fn get_output_derivatives(&mut self, vrs: &[u32], orders: &[i32], out: &mut [f64]) -> FmiResult {
+    pub fn get_output_derivatives(
+        &mut self,
+        vrs: &[u32],
+        orders: &[i32],
+        out: &mut [f64],
+    ) -> FmiResult {
         let sim = self.current()?;
         for ((vr, order), out) in vrs.iter().zip(orders).zip(out) {
             let var = Self::variable(Kind::Real, *vr)?;

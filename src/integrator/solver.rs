@@ -68,6 +68,9 @@ pub struct Solver<const N: usize> {
     #[serde(with = "super::serde_array")]
     k1: [f64; N],
     k1_valid: bool,
+    /// An edge was just crossed: the state may lie a rounding error short of it, on the side
+    /// of the piece it left, and must not be sent back there.
+    just_crossed: bool,
 }
 
 impl<const N: usize> Solver<N> {
@@ -80,6 +83,7 @@ impl<const N: usize> Solver<N> {
             controller: Controller::default(),
             k1: [0.0; N],
             k1_valid: false,
+            just_crossed: false,
         }
     }
 
@@ -87,6 +91,7 @@ impl<const N: usize> Solver<N> {
     /// the stored derivative no longer holds.
     pub fn invalidate(&mut self) {
         self.k1_valid = false;
+        self.just_crossed = false;
     }
 
     /// Step size the next step will try.
@@ -114,7 +119,7 @@ impl<const N: usize> Solver<N> {
         let mut steps = 0u64;
         let mut crossings_here = 0u32;
         while *t < t_end {
-            if sys.settle(*t, y) > 0 {
+            if !self.just_crossed && sys.settle(*t, y) > 0 {
                 self.invalidate();
             }
             let k1 = self.derivative(sys, *t, y);
@@ -147,7 +152,9 @@ impl<const N: usize> Solver<N> {
             self.stats.accepted += 1;
             let (lo, hi) = sys.piece();
             if let Some((edge, theta)) = locate_edge::<S, N>(&trial, lo, hi) {
-                // Redo the step so that it ends on the edge, then cross it.
+                // Redo the step so that it ends on the edge, then cross it. The state is kept
+                // as the step gives it (not moved onto the edge: where the force is not zero
+                // there, that would add or remove energy at every crossing).
                 if theta > 0.0 {
                     let redo = dopri5::step(sys, *t, y, &k1, theta * h);
                     self.stats.rhs_evals += EVALS_PER_STEP;
@@ -160,14 +167,15 @@ impl<const N: usize> Solver<N> {
                         return Err(SolverError::Chattering { t: *t });
                     }
                 }
-                y[S::GUARD] = if edge == Edge::Lower { lo } else { hi };
                 sys.cross(edge, *t, y);
                 self.stats.edges += 1;
-                self.invalidate();
+                self.k1_valid = false;
+                self.just_crossed = true;
                 self.h = verdict.h_next.max(theta * h);
                 continue;
             }
             crossings_here = 0;
+            self.just_crossed = false;
             *t = if last { t_end } else { *t + h };
             *y = trial.y1;
             self.k1 = *trial.k_end();
@@ -243,6 +251,12 @@ fn locate_edge<S: Piecewise<N>, const N: usize>(
             Edge::Lower => rate < 0.0,
             Edge::Upper => rate > 0.0,
         };
+        // Starting on the edge or a rounding error beyond it (just after crossing it the
+        // other way) and moving out: the trajectory leaves at once.
+        let on_or_beyond = outside(trial.y0[g]) || trial.y0[g] == level;
+        if on_or_beyond && outward(trial.y0[r]) {
+            return Some(0.0);
+        }
         let (a, b) = match (outward(trial.y0[r]), outward(trial.y1[r])) {
             (true, false) => {
                 let th = extremum();

@@ -231,7 +231,11 @@ impl ContactLaw {
             Region::ContactPlus => (1.0, 0.0, xi),
             Region::ContactMinus => (1.0, 0.0, xi - self.G),
             Region::BandPlus | Region::BandMinus => {
-                let delta = if region == Region::BandPlus { xi } else { xi - self.G };
+                let delta = if region == Region::BandPlus {
+                    xi
+                } else {
+                    xi - self.G
+                };
                 let ds = self.half_pi_over_eps * (2.0 * self.half_pi_over_eps * delta).sin();
                 (self.smoothing(delta), ds, delta)
             }
@@ -280,7 +284,10 @@ mod tests {
                 let slopes = law.slopes(region, xi, v);
                 let d_xi = (f(xi + h, v) - f(xi - h, v)) / (2.0 * h);
                 let d_v = (f(xi, v + 1e-6) - f(xi, v - 1e-6)) / 2e-6;
-                assert!((slopes.d_xi - d_xi).abs() <= 1e-4 * d_xi.abs().max(1.0), "{alpha} {xi:e}");
+                assert!(
+                    (slopes.d_xi - d_xi).abs() <= 1e-4 * d_xi.abs().max(1.0),
+                    "{alpha} {xi:e}"
+                );
                 assert!((slopes.d_xi_dot - d_v).abs() <= 1e-6 * d_v.abs().max(1.0));
             }
         }
