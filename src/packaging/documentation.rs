@@ -40,6 +40,22 @@ does not move), so outputs read right after reflect them.</p>
 r = simulate_fmu("GearRattle.fmu", stop_time=1.0, output_interval=1e-5,
                  start_values={"excitation": 1, "f_exc": 30.0, "A_rms": 300.0},
                  output=["xi", "a_pitch_L", "impacts_Fplus", "impacts_Fminus"])</pre>
+<h2>Use from libcosim</h2>
+<p>In a drivetrain (<code>excitation = 0</code>): the partner drives <code>theta_M</code>,
+<code>omega_M</code>, <code>alpha_M</code> (value references 20, 21, 22) and takes <code>tau_M</code>
+(value reference 37). With libcosimpy and a main-shaft FMU whose outputs theta_M, omega_M,
+alpha_M are value references 20, 21, 22 and whose torque input is 10 (the repository's
+partners/flywheel):</p>
+<pre>from libcosimpy.CosimExecution import CosimExecution
+from libcosimpy.CosimSlave import CosimLocalSlave
+
+ex = CosimExecution.from_step_size(step_size=100_000)          # 0.1 ms, in ns
+gear = ex.add_local_slave(CosimLocalSlave(fmu_path="GearRattle.fmu", instance_name="gear"))
+shaft = ex.add_local_slave(CosimLocalSlave(fmu_path="Flywheel.fmu", instance_name="flywheel"))
+for vr in (20, 21, 22):                                        # theta_M, omega_M, alpha_M
+    ex.connect_real_variables(shaft, vr, gear, vr)
+ex.connect_real_variables(gear, 37, shaft, 10)                  # tau_M -> the shaft
+ex.simulate_until(target_time=500_000_000)                      # 0.5 s</pre>
 "#;
 
 fn start(s: &Start) -> String {
