@@ -40,7 +40,8 @@ demo: fmu $(VENV)/.installed
 ## test: every test: Rust (cargo test) and the FMU as a user runs it (pytest + fmpy)
 test: $(TEST_TARGETS)
 
-test-rust: | libclang
+# The C-API tests load the cdylib, which `cargo test` alone does not produce.
+test-rust: $(LIB) | libclang
 	cargo test --release
 
 test-python: fmu $(VENV)/.installed

@@ -18,7 +18,7 @@ fn cdylib() -> PathBuf {
     let lib = profile_dir().join("libgear_rattle.so");
     assert!(
         lib.exists(),
-        "{} is missing: cargo builds it with the tests",
+        "{} is missing: build it first with `cargo build --release --lib` (make test does)",
         lib.display()
     );
     lib
