@@ -55,6 +55,9 @@ pub struct Trial<const N: usize> {
     pub err: [f64; N],
     /// f(t, y0) and the stages needed by the dense output; k7 = f(t + h, y1).
     k: [[f64; N]; 6],
+    /// The argument of the 6th stage (at t + h, like k7): Hairer's stiffness estimate
+    /// compares k7 − k6 with y1 − y6.
+    y6: [f64; N],
 }
 
 #[inline]
@@ -88,14 +91,12 @@ pub fn step<S: System<N>, const N: usize>(
         t + C5 * h,
         &combine(y0, h, &[(A51, k1), (A52, &k2), (A53, &k3), (A54, &k4)]),
     );
-    let k6 = sys.rhs(
-        t + h,
-        &combine(
-            y0,
-            h,
-            &[(A61, k1), (A62, &k2), (A63, &k3), (A64, &k4), (A65, &k5)],
-        ),
+    let y6 = combine(
+        y0,
+        h,
+        &[(A61, k1), (A62, &k2), (A63, &k3), (A64, &k4), (A65, &k5)],
     );
+    let k6 = sys.rhs(t + h, &y6);
     let y1 = combine(
         y0,
         h,
@@ -120,6 +121,7 @@ pub fn step<S: System<N>, const N: usize>(
         y1,
         err,
         k: [*k1, k3, k4, k5, k6, k7],
+        y6,
     }
 }
 
@@ -127,6 +129,12 @@ impl<const N: usize> Trial<N> {
     /// f(t + h, y1): the first stage of the next step (FSAL).
     pub fn k_end(&self) -> &[f64; N] {
         &self.k[5]
+    }
+
+    /// The 6th stage's argument and value (y6, k6 = f(t + h, y6)), for the stiffness estimate
+    /// h·‖k7 − k6‖ / ‖y1 − y6‖ of Hairer's DOPRI5 (see `radau5::stiffness`).
+    pub fn stage6(&self) -> (&[f64; N], &[f64; N]) {
+        (&self.y6, &self.k[4])
     }
 
     /// Component i of the dense output at t + θh, θ ∈ [0, 1].

@@ -9,11 +9,14 @@
 
 pub mod control;
 pub mod dopri5;
+pub mod linalg;
+pub mod radau5;
 pub mod roots;
 pub mod serde_array;
 pub mod solver;
 
 pub use control::Tolerance;
+pub use radau5::Jacobian;
 pub use solver::{Solver, SolverError, Stats};
 
 /// An ODE y' = f(t, y) with N components.
