@@ -1,0 +1,218 @@
+//! `BENCH_PROFILE=1 cargo bench --bench work_precision`: GearRattle's integrator alone on
+//! S1 (1 s) at one tolerance (BENCH_PROFILE_RTOL, default 1e-9), repeated for
+//! BENCH_PROFILE_SECONDS (default 4) of CPU so that `perf record` can sample it, followed by a
+//! breakdown of its work: right-hand sides per region (counted through a wrapper of `Rattle`,
+//! the solver being generic over the system), the measured cost of one right-hand side in each
+//! region, hence the share of the time spent in right-hand sides, and the evaluations spent on
+//! edges and rejected steps. This is what says which lever of issue 3 would pay.
+
+use super::*;
+use gear_rattle::integrator::{Edge, Piecewise, System};
+use gear_rattle::physics::Region;
+use std::cell::Cell;
+
+const REGIONS: [(Region, &str); 5] = [
+    (Region::ContactPlus, "contact F+ (xi < -eps)"),
+    (Region::BandPlus, "band F+ (-eps..0)"),
+    (Region::Gap, "gap (0..G, free flight)"),
+    (Region::BandMinus, "band F- (G..G+eps)"),
+    (Region::ContactMinus, "contact F- (xi > G+eps)"),
+];
+
+fn index(r: Region) -> usize {
+    REGIONS.iter().position(|(x, _)| *x == r).expect("a region")
+}
+
+/// `Rattle` with its right-hand sides counted per region.
+struct Counted {
+    inner: Rattle,
+    evals: Cell<[u64; 5]>,
+}
+
+impl System<N> for Counted {
+    #[inline]
+    fn rhs(&self, t: f64, y: &State) -> State {
+        let mut e = self.evals.get();
+        e[index(self.inner.region)] += 1;
+        self.evals.set(e);
+        self.inner.rhs(t, y)
+    }
+}
+
+impl Piecewise<N> for Counted {
+    const GUARD: usize = XI;
+    const RATE: usize = XI_DOT;
+    fn piece(&self) -> (f64, f64) {
+        self.inner.piece()
+    }
+    fn cross(&mut self, edge: Edge, t: f64, y: &State) {
+        self.inner.cross(edge, t, y)
+    }
+}
+
+pub fn run(scenes: &[Scene]) {
+    let sc = scenes
+        .iter()
+        .find(|s| s.name == "S1-1s")
+        .expect("scene S1-1s in the reference");
+    let env = |k: &str, d: f64| {
+        std::env::var(k)
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(d)
+    };
+    let rtol = env("BENCH_PROFILE_RTOL", 1e-9);
+    let seconds = env("BENCH_PROFILE_SECONDS", 4.0);
+
+    // 1. The plain run, repeated (what perf samples).
+    let start = cpu_now();
+    let mut runs = 0;
+    let mut last = None;
+    while cpu_now() - start < seconds || runs == 0 {
+        last = Some(run_gearrattle(sc, rtol).expect("GearRattle run"));
+        runs += 1;
+    }
+    let per_run = (cpu_now() - start) / runs as f64;
+    let (sampled, _) = last.expect("one run");
+    let run = &sampled.run;
+
+    // 2. The same run with its right-hand sides counted per region.
+    let p = sc.params();
+    let mut sys = Counted {
+        inner: Rattle::new(Dynamics::new(p), excitation(sc), 0.5 * p.G),
+        evals: Cell::new([0; 5]),
+    };
+    let mut solver = Solver::new(sys.inner.tolerance(rtol));
+    let (mut t, mut y) = (0.0, y0(&p));
+    for tg in grid(sc.t_end) {
+        if tg > t {
+            solver.advance(&mut sys, &mut t, &mut y, tg).expect("run");
+        }
+    }
+    let evals = sys.evals.get();
+    let counted: u64 = evals.iter().sum();
+
+    // 3. The cost of one right-hand side in each region (states inside each region, the time
+    //    varied so that nothing is hoisted).
+    let eps = p.epsilon;
+    let states = [-3e-6, -0.5 * eps, 0.5 * p.G, p.G + 0.5 * eps, p.G + 3e-6];
+    let mut ns = [0.0; 5];
+    for (i, (region, _)) in REGIONS.iter().enumerate() {
+        let mut r = Rattle::new(Dynamics::new(p), excitation(sc), states[i]);
+        r.region = *region;
+        let n = 300_000;
+        let mut acc = 0.0;
+        let t0 = cpu_now();
+        for k in 0..n {
+            let yy = [states[i], 0.05, 0.0, 0.0, 0.0];
+            let f = std::hint::black_box(&r).rhs(k as f64 * 1e-7, std::hint::black_box(&yy));
+            acc += f[1];
+        }
+        ns[i] = (cpu_now() - t0) / n as f64 * 1e9;
+        std::hint::black_box(acc);
+    }
+    let rhs_time: f64 = (0..5).map(|i| evals[i] as f64 * ns[i] * 1e-9).sum();
+    // The same right-hand side written literally from MODEL.md, as a peer's user would write
+    // it (powf for |δ/G|^(α−1), the band's sine as written, sin and cos of the excitation).
+    let mut ns_literal = [0.0; 5];
+    for (i, (region, _)) in REGIONS.iter().enumerate() {
+        let n = 300_000;
+        let mut acc = 0.0;
+        let t0 = cpu_now();
+        for k in 0..n {
+            let yy = [states[i], 0.05, 0.0, 0.0, 0.0];
+            let f = literal_rhs(
+                std::hint::black_box(&p),
+                sc,
+                *region,
+                k as f64 * 1e-7,
+                std::hint::black_box(&yy),
+            );
+            acc += f[1];
+        }
+        ns_literal[i] = (cpu_now() - t0) / n as f64 * 1e9;
+        std::hint::black_box(acc);
+    }
+    let literal_time: f64 = (0..5).map(|i| evals[i] as f64 * ns_literal[i] * 1e-9).sum();
+
+    println!(
+        "GearRattle (direct), S1 1 s, rtol {rtol:e}: {:.3} ms CPU per run (mean of {runs}), \
+         max |dxi| over the run's 1 ms grid vs the reference: see rust.csv",
+        per_run * 1e3
+    );
+    println!(
+        "work: {} RHS, {} accepted + {} rejected steps, {} edges crossed",
+        run.rhs, solver.stats.accepted, solver.stats.rejected, run.edges
+    );
+    println!(
+        "RHS per accepted step {:.2}; RHS on edges (redo of the step to land on the edge + new first \
+         stage, 7 per edge) {:.0} % ; RHS on rejected steps (6 each) {:.0} %",
+        run.rhs as f64 / solver.stats.accepted as f64,
+        100.0 * 7.0 * run.edges as f64 / run.rhs as f64,
+        100.0 * 6.0 * solver.stats.rejected as f64 / run.rhs as f64
+    );
+    println!(
+        "RHS by region (counted run: {counted} RHS, {} outside the regions' count: initial step):",
+        run.rhs.saturating_sub(counted)
+    );
+    for (i, (_, name)) in REGIONS.iter().enumerate() {
+        println!(
+            "  {name:26} {:8} RHS ({:4.1} %)  {:5.1} ns each  {:5.1} % of the CPU time",
+            evals[i],
+            100.0 * evals[i] as f64 / counted as f64,
+            ns[i],
+            100.0 * evals[i] as f64 * ns[i] * 1e-9 / per_run
+        );
+    }
+    println!(
+        "literal MODEL.md RHS (powf, the band's sine as written): {} ns per region; the run's RHS \
+         would cost {:.0} % of GearRattle's RHS time",
+        ns_literal
+            .iter()
+            .map(|x| format!("{x:.1}"))
+            .collect::<Vec<_>>()
+            .join(" / "),
+        100.0 * literal_time / rhs_time
+    );
+    println!(
+        "right-hand sides {:.0} % of the CPU time; the rest ({:.0} %, {:.1} ns per RHS) is the \
+         integrator: stages, error norm, step control, edge search on the dense output, output stops",
+        100.0 * rhs_time / per_run,
+        100.0 * (1.0 - rhs_time / per_run),
+        (per_run - rhs_time) / run.rhs as f64 * 1e9
+    );
+}
+
+/// MODEL.md §2-3 written out literally for one region: the right-hand side a user of a
+/// general ODE crate would write (state [ξ, ξ', E_contact, E_lubricant, W_shaft]).
+fn literal_rhs(p: &GearParams, sc: &Scene, region: Region, t: f64, y: &State) -> State {
+    use std::f64::consts::PI;
+    let (xi, v) = (y[XI], y[XI_DOT]);
+    let w = 2.0 * PI * sc.f_exc;
+    let amp = 2f64.sqrt() * sc.A_rms;
+    let a_m = amp * (w * t).sin();
+    let om_m = -amp / w * (w * t).cos();
+    let (eps, g) = (p.epsilon, p.G);
+    let (s, delta) = match region {
+        Region::ContactPlus => (1.0, xi),
+        Region::BandPlus => (0.5 * (1.0 - (PI / eps * (eps / 2.0 + xi)).sin()), xi),
+        Region::Gap => (0.0, 0.0),
+        Region::BandMinus => (
+            0.5 * (1.0 - (PI / eps * (eps / 2.0 - (xi - g))).sin()),
+            xi - g,
+        ),
+        Region::ContactMinus => (1.0, xi - g),
+    };
+    let f_k = s * p.K_star * delta * (delta / g).abs().powf(p.alpha - 1.0);
+    let f_c = s * p.C_LM * v;
+    let f = f_k + f_c;
+    let om_l = (v + p.r_M * om_m) / p.r_L;
+    let dom_l = (p.B - p.r_L * f - p.C * (om_l - p.omega_S)) / p.I_L;
+    [
+        v,
+        p.r_L * dom_l - p.r_M * a_m,
+        f_c * v,
+        p.C * (om_l - p.omega_S) * (om_l - p.omega_S),
+        -p.r_M * f * om_m,
+    ]
+}

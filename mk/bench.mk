@@ -1,0 +1,48 @@
+# Work-precision benchmark (issue 3): `make bench` measures GearRattle beside its peers and
+# regenerates docs/BENCHMARKS.md and docs/work_precision.png. Not part of `make test`: it
+# takes about half an hour on the 2-core machine and makes no timed assertion.
+#
+#   make bench            everything (reference only when missing or outdated)
+#   make bench-reference  the independent reference alone (scripts/bench_reference.py)
+
+BENCH_DIR := target/bench
+BENCH_REF := $(BENCH_DIR)/reference/scenes.csv
+
+.PHONY: bench bench-reference bench-profile
+
+## bench: work-precision benchmark of issue 3 -> docs/BENCHMARKS.md, docs/work_precision.png
+bench: fmu $(VENV)/.installed $(BENCH_REF) | libclang
+	@started=$$(date +%s); \
+	mkdir -p $(BENCH_DIR); \
+	{ echo "Load average at the start: $$(cut -d' ' -f1-3 /proc/loadavg) (1, 5, 15 min)."; } > $(BENCH_DIR)/machine.txt; \
+	set -e; \
+	cargo bench --bench work_precision; \
+	$(PY) scripts/bench_python.py; \
+	tol=$$($(PY) -c "import csv; r=[x for x in csv.DictReader(open('$(BENCH_DIR)/rust.csv')) if x['solver']=='GearRattle (direct)' and x['scene']=='S1-1s' and x['status']=='ok' and float(x['err_max_xi'])<=1e-9]; print(max((float(x['rtol']) for x in r), default=1e-9))"); \
+	$(MAKE) --no-print-directory bench-profile BENCH_PROFILE_RTOL=$$tol; \
+	echo "Load average at the end: $$(cut -d' ' -f1-3 /proc/loadavg) (1, 5, 15 min)." >> $(BENCH_DIR)/machine.txt; \
+	$(PY) scripts/bench_report.py --started $$started
+
+## bench-profile: GearRattle alone on S1 under perf -> target/bench/profile.txt (part of bench)
+# The bench binary is built first and recorded alone, so that no compiler shows in the profile.
+BENCH_PROFILE_RTOL ?= 1e-7
+bench-profile: | libclang
+	@exe=$$(cargo bench --no-run --bench work_precision 2>&1 | grep -o 'target/release/deps/work_precision-[0-9a-f]*' | tail -n 1); \
+	test -x "$$exe" || { echo "bench binary not found"; exit 1; }; \
+	if command -v perf >/dev/null 2>&1; then \
+		BENCH_PROFILE=1 BENCH_PROFILE_RTOL=$(BENCH_PROFILE_RTOL) perf record -q -F 999 -o $(BENCH_DIR)/perf.data -- \
+			$$exe --bench > $(BENCH_DIR)/profile.txt; \
+		{ echo; echo "perf report (self time, symbols over 1 %):"; \
+		  perf report -i $(BENCH_DIR)/perf.data --stdio --no-children --sort symbol --percent-limit 1 2>/dev/null \
+			| grep -v '^#' | grep -v '^$$' | sed -E 's/[[:space:]]+-[[:space:]]+-[[:space:]]*$$//; s/[[:space:]]+$$//' | head -25; \
+		} >> $(BENCH_DIR)/profile.txt; \
+	else \
+		BENCH_PROFILE=1 BENCH_PROFILE_RTOL=$(BENCH_PROFILE_RTOL) $$exe --bench > $(BENCH_DIR)/profile.txt; \
+	fi; \
+	cat $(BENCH_DIR)/profile.txt
+
+## bench-reference: the independent reference solutions of the benchmark scenes
+bench-reference: $(BENCH_REF)
+
+$(BENCH_REF): scripts/bench_reference.py tests/python/reference.py | $(VENV)/.installed
+	$(PY) scripts/bench_reference.py --out $(BENCH_DIR)/reference
