@@ -40,6 +40,11 @@ does not move), so outputs read right after reflect them.</p>
 r = simulate_fmu("GearRattle.fmu", stop_time=1.0, output_interval=1e-5,
                  start_values={"excitation": 1, "f_exc": 30.0, "A_rms": 300.0},
                  output=["xi", "a_pitch_L", "impacts_Fplus", "impacts_Fminus"])</pre>
+<h2>Error against run time</h2>
+<p>Error (max |Δξ| against a tight independent reference) against CPU time on the paper's
+scene S1, beside Rust ODE crates and scipy on the same equations (<code>make bench</code> in the
+repository; docs/BENCHMARKS.md there has the tables).</p>
+<img src="work_precision.png" alt="work-precision plot" style="max-width:100%">
 <h2>Use from libcosim</h2>
 <p>In a drivetrain (<code>excitation = 0</code>): the partner drives <code>theta_M</code>,
 <code>omega_M</code>, <code>alpha_M</code> (value references 20, 21, 22) and takes <code>tau_M</code>
@@ -57,6 +62,9 @@ for vr in (20, 21, 22):                                        # theta_M, omega_
 ex.connect_real_variables(gear, 37, shaft, 10)                  # tau_M -> the shaft
 ex.simulate_until(target_time=500_000_000)                      # 0.5 s</pre>
 "#;
+
+/// The work-precision plot of `make bench` (docs/work_precision.png), shown on the page.
+pub const WORK_PRECISION_PNG: &[u8] = include_bytes!("../../docs/work_precision.png");
 
 fn start(s: &Start) -> String {
     match s {

@@ -28,6 +28,8 @@ pub fn write_fmu(out: &Path, binaries: &[Binary]) -> std::io::Result<()> {
     zip.write_all(MODEL_DESCRIPTION_XML.as_bytes())?;
     zip.start_file("documentation/index.html", options)?;
     zip.write_all(documentation::index_html().as_bytes())?;
+    zip.start_file("documentation/work_precision.png", options)?;
+    zip.write_all(documentation::WORK_PRECISION_PNG)?;
     for b in binaries {
         let name = format!("binaries/{}/{MODEL_IDENTIFIER}.{}", b.platform, b.extension);
         zip.start_file(name, options.unix_permissions(0o755))?;
