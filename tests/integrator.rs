@@ -101,20 +101,31 @@ fn the_step_size_carries_over_between_calls() {
     assert!(e100 < 10.0 * e1.max(1e-12), "{e100:e} vs {e1:e}");
 }
 
-/// x'' = −1 above the edge x = 0 and +1 below it: the exact solution is piecewise
-/// quadratic, crossing 0 at t = (2k+1)√2 from x(0) = 1, x'(0) = 0.
-struct Bounce {
+/// x'' = a_above while x ≥ 0 and a_below while x ≤ 0: piecewise quadratic exact solutions,
+/// with the crossings of x = 0 recorded.
+struct TwoPieces {
+    accel: [f64; 2],
     below: bool,
     crossings: Vec<(f64, Edge)>,
 }
 
-impl System<2> for Bounce {
-    fn rhs(&self, _t: f64, y: &[f64; 2]) -> [f64; 2] {
-        [y[1], if self.below { 1.0 } else { -1.0 }]
+impl TwoPieces {
+    fn new(a_above: f64, a_below: f64) -> Self {
+        TwoPieces {
+            accel: [a_above, a_below],
+            below: false,
+            crossings: vec![],
+        }
     }
 }
 
-impl Piecewise<2> for Bounce {
+impl System<2> for TwoPieces {
+    fn rhs(&self, _t: f64, y: &[f64; 2]) -> [f64; 2] {
+        [y[1], self.accel[self.below as usize]]
+    }
+}
+
+impl Piecewise<2> for TwoPieces {
     const GUARD: usize = 0;
     const RATE: usize = 1;
     fn piece(&self) -> (f64, f64) {
@@ -130,10 +141,10 @@ impl Piecewise<2> for Bounce {
     }
 }
 
-fn run(sys: &mut Bounce, y0: [f64; 2], t_end: f64, chunks: usize) -> Vec<(f64, Edge)> {
+fn run(sys: &mut TwoPieces, y0: [f64; 2], t_end: f64, chunks: usize, tol: f64) -> Vec<(f64, Edge)> {
     let tol = Tolerance {
-        rtol: 1e-8,
-        atol: [1e-8, 1e-8],
+        rtol: tol,
+        atol: [tol, tol],
         controlled: 2,
     };
     let mut solver = Solver::new(tol);
@@ -146,14 +157,12 @@ fn run(sys: &mut Bounce, y0: [f64; 2], t_end: f64, chunks: usize) -> Vec<(f64, E
     std::mem::take(&mut sys.crossings)
 }
 
+/// x'' = −1 above 0 and +1 below, from x(0) = 1 at rest: crossings at t = (2k+1)√2.
 #[test]
 fn edges_are_located_exactly_and_crossed_once() {
     for chunks in [1, 7, 1000] {
-        let mut sys = Bounce {
-            below: false,
-            crossings: vec![],
-        };
-        let crossings = run(&mut sys, [1.0, 0.0], 20.0, chunks);
+        let mut sys = TwoPieces::new(-1.0, 1.0);
+        let crossings = run(&mut sys, [1.0, 0.0], 20.0, chunks, 1e-8);
         let expected: Vec<f64> = (0..7).map(|k| (2 * k + 1) as f64 * 2f64.sqrt()).collect();
         assert_eq!(crossings.len(), expected.len(), "{crossings:?}");
         for (k, ((t, edge), want)) in crossings.iter().zip(&expected).enumerate() {
@@ -168,48 +177,14 @@ fn edges_are_located_exactly_and_crossed_once() {
 }
 
 /// A trajectory that dips 10 nm below the edge for 0.3 ms and comes back is caught even
-/// though a single step of the (exact, quadratic) solution could jump over the dip.
+/// though a single step of the (exact, quadratic) solution could jump over the dip:
+/// x = 1e-8 − 2e-4 t + t²/2, minimum −1e-8 at t = 2e-4, roots at 2e-4 ∓ √2·1e-4.
 #[test]
 fn a_graze_inside_one_step_is_not_skipped() {
-    struct Graze {
-        crossings: Vec<(f64, Edge)>,
-        below: bool,
-    }
-    impl System<2> for Graze {
-        fn rhs(&self, _t: f64, y: &[f64; 2]) -> [f64; 2] {
-            [y[1], 1.0]
-        }
-    }
-    impl Piecewise<2> for Graze {
-        const GUARD: usize = 0;
-        const RATE: usize = 1;
-        fn piece(&self) -> (f64, f64) {
-            if self.below {
-                (f64::NEG_INFINITY, 0.0)
-            } else {
-                (0.0, f64::INFINITY)
-            }
-        }
-        fn cross(&mut self, edge: Edge, t: f64, _: &[f64; 2]) {
-            self.below = edge == Edge::Lower;
-            self.crossings.push((t, edge));
-        }
-    }
-    // x = 1e-8 − 2e-4 t + t²/2: minimum −1e-8 at t = 2e-4; roots at 2e-4 ∓ √2e-4.
-    let mut sys = Graze {
-        crossings: vec![],
-        below: false,
-    };
-    let tol = Tolerance {
-        rtol: 1e-3,
-        atol: [1.0, 1.0],
-        controlled: 2,
-    };
-    let mut solver = Solver::new(tol);
-    let (mut t, mut y) = (0.0, [1e-8, -2e-4]);
-    solver.advance(&mut sys, &mut t, &mut y, 1.0).unwrap();
+    let mut sys = TwoPieces::new(1.0, 1.0);
+    let crossings = run(&mut sys, [1e-8, -2e-4], 1.0, 1, 1e-3);
     let roots = [2e-4 - 2f64.sqrt() * 1e-4, 2e-4 + 2f64.sqrt() * 1e-4];
-    assert_eq!(sys.crossings.len(), 2, "{:?}", sys.crossings);
-    assert!((sys.crossings[0].0 - roots[0]).abs() < 1e-9);
-    assert!((sys.crossings[1].0 - roots[1]).abs() < 1e-9);
+    assert_eq!(crossings.len(), 2, "{crossings:?}");
+    assert!((crossings[0].0 - roots[0]).abs() < 1e-9);
+    assert!((crossings[1].0 - roots[1]).abs() < 1e-9);
 }
