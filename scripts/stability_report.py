@@ -26,6 +26,8 @@ import sys
 import tempfile
 import time
 
+from bench_report import lscpu  # the machine, read the same way as the benchmark
+
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests" / "python"))
 
@@ -35,19 +37,6 @@ MIN_CPU = 0.2  # s of CPU per timing sample group
 MAX_REPEATS = 25
 COMMAND = "make stability"
 BASE = "S1"
-
-
-def lscpu() -> dict:
-    try:
-        out = subprocess.run(["lscpu"], capture_output=True, text=True, check=True).stdout
-    except (OSError, subprocess.CalledProcessError):
-        return {}
-    d = {}
-    for line in out.splitlines():
-        if ":" in line:
-            k, v = line.split(":", 1)
-            d[k.strip()] = v.strip()
-    return d
 
 
 def git_state() -> str:
