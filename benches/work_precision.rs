@@ -2,7 +2,7 @@
 //! called directly, the FMU through its C API, and maintained Rust ODE crates on the same
 //! equations, measured side by side (interleaved repeats) in one run.
 //!
-//!     cargo bench --bench work_precision          (or `make bench`, which runs everything)
+//!     cargo bench -p gear_rattle_bench --bench work_precision          (or `make bench`, which runs everything)
 //!
 //! Needs the reference of `scripts/bench_python.py reference` (target/bench/reference/: the
 //! scenes, their predictable windows and an independent tight solution on a 1 ms grid) and
@@ -633,7 +633,8 @@ fn cost_at(points: &[(f64, f64)], target: f64) -> Option<(f64, bool)> {
 }
 
 fn main() {
-    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    // The repository root: this crate lives in benches/.
+    let root = PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/.."));
     let ref_dir = root.join("target/bench/reference");
     if let Ok(which) = std::env::var("BENCH_DEBUG") {
         let scenes = load_scenes(&ref_dir);

@@ -16,7 +16,7 @@ bench: fmu $(VENV)/.installed $(BENCH_REF) | libclang
 	mkdir -p $(BENCH_DIR); \
 	{ echo "Load average at the start: $$(cut -d' ' -f1-3 /proc/loadavg) (1, 5, 15 min)."; } > $(BENCH_DIR)/machine.txt; \
 	set -e; \
-	cargo bench --bench work_precision; \
+	cargo bench -p gear_rattle_bench --bench work_precision; \
 	$(PY) scripts/bench_python.py; \
 	tol=$$($(PY) -c "import csv; r=[x for x in csv.DictReader(open('$(BENCH_DIR)/rust.csv')) if x['solver']=='GearRattle (direct)' and x['scene']=='S1-1s' and x['status']=='ok' and float(x['err_max_xi'])<=1e-9]; print(max((float(x['rtol']) for x in r), default=1e-9))"); \
 	$(MAKE) --no-print-directory bench-profile BENCH_PROFILE_RTOL=$$tol; \
@@ -27,7 +27,7 @@ bench: fmu $(VENV)/.installed $(BENCH_REF) | libclang
 # The bench binary is built first and recorded alone, so that no compiler shows in the profile.
 BENCH_PROFILE_RTOL ?= 1e-7
 bench-profile: | libclang
-	@exe=$$(cargo bench --no-run --bench work_precision 2>&1 | grep -o 'target/release/deps/work_precision-[0-9a-f]*' | tail -n 1); \
+	@exe=$$(cargo bench -p gear_rattle_bench --no-run --bench work_precision 2>&1 | grep -o 'target/release/deps/work_precision-[0-9a-f]*' | tail -n 1); \
 	test -x "$$exe" || { echo "bench binary not found"; exit 1; }; \
 	if command -v perf >/dev/null 2>&1; then \
 		BENCH_PROFILE=1 BENCH_PROFILE_RTOL=$(BENCH_PROFILE_RTOL) perf record -q -F 999 -o $(BENCH_DIR)/perf.data -- \

@@ -3,7 +3,7 @@ docs/BENCHMARKS.md (issue 3).
 
     .venv/bin/python scripts/bench_report.py [--started EPOCH_SECONDS]
 
-Reads target/bench/rust.csv (cargo bench --bench work_precision), target/bench/python.csv
+Reads target/bench/rust.csv (cargo bench -p gear_rattle_bench --bench work_precision), target/bench/python.csv
 (scripts/bench_python.py), target/bench/reference/scenes.csv (scripts/bench_reference.py)
 and, when present, target/bench/profile.txt and target/bench/machine.txt (written by
 mk/bench.mk). Ratios, not absolute times, carry the claims.
@@ -539,7 +539,7 @@ def main() -> None:
     w("  1. `make fmu` (target/fmu/GearRattle.fmu);")
     w("  2. `.venv/bin/python scripts/bench_reference.py` (only when it or tests/python/reference.py changed: "
       "target/bench/reference/; about 8 minutes more, mostly the Radau checks);")
-    w("  3. `cargo bench --bench work_precision` (target/bench/rust.csv; `BENCH_QUICK=1` for a smoke run, "
+    w("  3. `cargo bench -p gear_rattle_bench --bench work_precision` (target/bench/rust.csv; `BENCH_QUICK=1` for a smoke run, "
       "`BENCH_SCENES=S1-1s,...` for a subset);")
     w("  4. `.venv/bin/python scripts/bench_python.py` (target/bench/python.csv; `--scenes all` for every scene);")
     w("  5. `perf record` of GearRattle alone on S1 (target/bench/profile.txt, when perf is available);")
@@ -708,7 +708,7 @@ def main() -> None:
         w("## Profile of GearRattle (direct) on S1")
         w("")
         w("`perf record` of the GearRattle integrator alone on S1, 1 s, at the tolerance that reaches 1e-9 m "
-          "(`BENCH_PROFILE=1 cargo bench --bench work_precision`); self time per symbol, top entries:")
+          "(`BENCH_PROFILE=1 cargo bench -p gear_rattle_bench --bench work_precision`); self time per symbol, top entries:")
         w("")
         w("```")
         w(prof.read_text().rstrip())
