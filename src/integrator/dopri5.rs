@@ -2,7 +2,7 @@
 //! DOPRI5: the 5th-order solution is propagated, the embedded 4th-order one gives the error
 //! estimate, and a continuous extension of order 4 interpolates inside the step.
 
-use super::System;
+use super::{Dense, System};
 
 const C2: f64 = 1.0 / 5.0;
 const C3: f64 = 3.0 / 10.0;
@@ -147,5 +147,14 @@ impl<const N: usize> Trial<N> {
         let r5 = h * (D1 * k1[i] + D3 * k3[i] + D4 * k4[i] + D5 * k5[i] + D6 * k6[i] + D7 * k7[i]);
         let theta1 = 1.0 - theta;
         self.y0[i] + theta * (ydiff + theta1 * (bspl + theta * (r4 + theta1 * r5)))
+    }
+}
+
+impl<const N: usize> Dense<N> for Trial<N> {
+    fn ends(&self) -> (&[f64; N], &[f64; N]) {
+        (&self.y0, &self.y1)
+    }
+    fn dense(&self, i: usize, theta: f64) -> f64 {
+        Trial::dense(self, i, theta)
     }
 }

@@ -24,6 +24,14 @@ pub trait System<const N: usize> {
     fn rhs(&self, t: f64, y: &[f64; N]) -> [f64; N];
 }
 
+/// A step's ends and its dense output, whichever method took it: what edge location needs.
+pub trait Dense<const N: usize> {
+    /// y at the start and at the end of the step.
+    fn ends(&self) -> (&[f64; N], &[f64; N]);
+    /// Component i at t + θh, θ ∈ [0, 1].
+    fn dense(&self, i: usize, theta: f64) -> f64;
+}
+
 /// Which edge of the current piece a trajectory leaves through.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Edge {

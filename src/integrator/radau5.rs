@@ -30,10 +30,10 @@
 use nalgebra::{Complex, DMatrix, SMatrix};
 use serde::{Deserialize, Serialize};
 
-use super::System;
 use super::control::{Tolerance, Verdict};
 use super::dopri5;
 use super::linalg::Lu;
+use super::{Dense, System};
 
 /// A system that supplies its Jacobian: `jacobian(t, y)[i][j]` = ∂f_i/∂y_j at (t, y).
 pub trait Jacobian<const N: usize>: System<N> {
@@ -162,6 +162,15 @@ impl<const N: usize> RadauTrial<N> {
         let s = theta - 1.0;
         let [c1, c2, c3] = &self.cont;
         self.y1[i] + s * (c1[i] + (s - C2M1) * (c2[i] + (s - C1M1) * c3[i]))
+    }
+}
+
+impl<const N: usize> Dense<N> for RadauTrial<N> {
+    fn ends(&self) -> (&[f64; N], &[f64; N]) {
+        (&self.y0, &self.y1)
+    }
+    fn dense(&self, i: usize, theta: f64) -> f64 {
+        RadauTrial::dense(self, i, theta)
     }
 }
 
@@ -746,7 +755,7 @@ impl StiffnessDetector {
 mod tests {
     use super::*;
     use crate::integrator::control::Controller;
-    use crate::integrator::roots::illinois;
+    use crate::integrator::solver::locate_edge;
     use crate::integrator::{Edge, Piecewise, Solver};
 
     fn tolerance<const N: usize>(rtol: f64, atol: [f64; N]) -> Tolerance<N> {
@@ -759,78 +768,6 @@ mod tests {
 
     /// What edge location needs of a trial: both ends and the dense output (DOPRI5's and
     /// Radau's have the same shape).
-    trait Dense<const N: usize> {
-        fn ends(&self) -> (&[f64; N], &[f64; N]);
-        fn dense(&self, i: usize, theta: f64) -> f64;
-    }
-    impl<const N: usize> Dense<N> for RadauTrial<N> {
-        fn ends(&self) -> (&[f64; N], &[f64; N]) {
-            (&self.y0, &self.y1)
-        }
-        fn dense(&self, i: usize, theta: f64) -> f64 {
-            RadauTrial::dense(self, i, theta)
-        }
-    }
-    impl<const N: usize> Dense<N> for dopri5::Trial<N> {
-        fn ends(&self) -> (&[f64; N], &[f64; N]) {
-            (&self.y0, &self.y1)
-        }
-        fn dense(&self, i: usize, theta: f64) -> f64 {
-            dopri5::Trial::dense(self, i, theta)
-        }
-    }
-
-    /// Where the dense output of an accepted trial leaves [lo, hi] on the guard component:
-    /// the driver's rule (solver.rs, `locate_edge`), on either method's dense output.
-    fn locate_edge<T: Dense<N>, const N: usize>(
-        trial: &T,
-        (g, r): (usize, usize),
-        lo: f64,
-        hi: f64,
-    ) -> Option<(Edge, f64)> {
-        let (y0, y1) = trial.ends();
-        let extremum = || illinois(|th| trial.dense(r, th), 0.0, 1.0, 1e-12);
-        let find = |edge: Edge, level: f64| -> Option<f64> {
-            let outside = |v: f64| match edge {
-                Edge::Lower => v < level,
-                Edge::Upper => v > level,
-            };
-            let outward = |rate: f64| match edge {
-                Edge::Lower => rate < 0.0,
-                Edge::Upper => rate > 0.0,
-            };
-            let (a, b) = match (outward(y0[r]), outward(y1[r])) {
-                (true, false) => {
-                    let th = extremum();
-                    if !outside(trial.dense(g, th)) {
-                        return None;
-                    }
-                    (0.0, th)
-                }
-                (false, true) if outside(y1[g]) => (extremum(), 1.0),
-                _ if outside(y1[g]) => (0.0, 1.0),
-                _ => return None,
-            };
-            Some(illinois(|th| trial.dense(g, th) - level, a, b, 1e-13))
-        };
-        let lower = if lo.is_finite() {
-            find(Edge::Lower, lo)
-        } else {
-            None
-        };
-        let upper = if hi.is_finite() {
-            find(Edge::Upper, hi)
-        } else {
-            None
-        };
-        match (lower, upper) {
-            (Some(a), Some(b)) if b < a => Some((Edge::Upper, b)),
-            (Some(a), _) => Some((Edge::Lower, a)),
-            (None, Some(b)) => Some((Edge::Upper, b)),
-            (None, None) => None,
-        }
-    }
-
     #[derive(Debug)]
     struct Run<const N: usize> {
         y: [f64; N],

@@ -3,9 +3,9 @@
 //! keeps its step size and controller memory from one call to the next.
 
 use super::control::{Controller, Tolerance};
-use super::dopri5::{self, EVALS_PER_STEP, Trial};
+use super::dopri5::{self, EVALS_PER_STEP};
 use super::roots::illinois;
-use super::{Edge, Piecewise};
+use super::{Dense, Edge, Piecewise};
 use serde::{Deserialize, Serialize};
 
 /// Work counters, as DOPRI5 reports them.
@@ -151,7 +151,7 @@ impl<const N: usize> Solver<N> {
             }
             self.stats.accepted += 1;
             let (lo, hi) = sys.piece();
-            if let Some((edge, theta)) = locate_edge::<S, N>(&trial, lo, hi) {
+            if let Some((edge, theta)) = locate_edge(&trial, (S::GUARD, S::RATE), lo, hi) {
                 // Redo the step so that it ends on the edge, then cross it. The state is kept
                 // as the step gives it (not moved onto the edge: where the force is not zero
                 // there, that would add or remove energy at every crossing).
@@ -235,12 +235,13 @@ impl<const N: usize> Solver<N> {
 /// decided by the extremum, so it is not skipped), moving in then out (the exit can only come
 /// after the extremum, which matters when the step starts on the edge it just crossed), or
 /// monotone.
-fn locate_edge<S: Piecewise<N>, const N: usize>(
-    trial: &Trial<N>,
+pub(crate) fn locate_edge<T: Dense<N>, const N: usize>(
+    trial: &T,
+    (g, r): (usize, usize),
     lo: f64,
     hi: f64,
 ) -> Option<(Edge, f64)> {
-    let (g, r) = (S::GUARD, S::RATE);
+    let (y0, y1) = trial.ends();
     let extremum = || illinois(|th| trial.dense(r, th), 0.0, 1.0, 1e-12);
     let find = |edge: Edge, level: f64| -> Option<f64> {
         let outside = |v: f64| match edge {
@@ -253,11 +254,11 @@ fn locate_edge<S: Piecewise<N>, const N: usize>(
         };
         // Starting on the edge or a rounding error beyond it (just after crossing it the
         // other way) and moving out: the trajectory leaves at once.
-        let on_or_beyond = outside(trial.y0[g]) || trial.y0[g] == level;
-        if on_or_beyond && outward(trial.y0[r]) {
+        let on_or_beyond = outside(y0[g]) || y0[g] == level;
+        if on_or_beyond && outward(y0[r]) {
             return Some(0.0);
         }
-        let (a, b) = match (outward(trial.y0[r]), outward(trial.y1[r])) {
+        let (a, b) = match (outward(y0[r]), outward(y1[r])) {
             (true, false) => {
                 let th = extremum();
                 if !outside(trial.dense(g, th)) {
@@ -265,8 +266,8 @@ fn locate_edge<S: Piecewise<N>, const N: usize>(
                 }
                 (0.0, th)
             }
-            (false, true) if outside(trial.y1[g]) => (extremum(), 1.0),
-            _ if outside(trial.y1[g]) => (0.0, 1.0),
+            (false, true) if outside(y1[g]) => (extremum(), 1.0),
+            _ if outside(y1[g]) => (0.0, 1.0),
             _ => return None,
         };
         Some(illinois(|th| trial.dense(g, th) - level, a, b, 1e-13))
