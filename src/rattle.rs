@@ -6,7 +6,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::integrator::{Edge, Piecewise, System, Tolerance};
+use crate::integrator::{Edge, Jacobian, Piecewise, System, Tolerance};
 use crate::physics::{Dynamics, Excitation, Region};
 
 /// Components of the state vector.
@@ -85,6 +85,24 @@ impl System<N> for Rattle {
     }
 }
 
+impl Jacobian<N> for Rattle {
+    /// ∂f/∂y of `rhs` for Radau IIA: the contact's slopes (MODEL.md §2) through the equation of
+    /// motion (§3), ∂ξ''/∂ξ = −(r_L²/I_L) ∂F/∂ξ and ∂ξ''/∂ξ' = −(r_L²/I_L) ∂F/∂ξ' − C/I_L. The
+    /// rows of the quadratures (energies, work) are left zero: they do not act back on ξ, ξ',
+    /// so Radau's simplified Newton iteration gives them their exact stage values from those
+    /// of ξ, ξ' in each iteration, and they are outside the error control.
+    fn jacobian(&self, _t: f64, y: &State) -> [[f64; N]; N] {
+        let p = &self.dynamics.params;
+        let slopes = self.dynamics.law.slopes(self.region, y[XI], y[XI_DOT]);
+        let lever = p.r_L * p.r_L / p.I_L;
+        let mut j = [[0.0; N]; N];
+        j[XI][XI_DOT] = 1.0;
+        j[XI_DOT][XI] = -lever * slopes.d_xi;
+        j[XI_DOT][XI_DOT] = -lever * slopes.d_xi_dot - p.C / p.I_L;
+        j
+    }
+}
+
 impl Piecewise<N> for Rattle {
     const GUARD: usize = XI;
     const RATE: usize = XI_DOT;
@@ -105,5 +123,41 @@ impl Piecewise<N> for Rattle {
             self.impacts.last_speed = y[XI_DOT].abs();
         }
         self.region = next;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::physics::{GearParams, Sine};
+
+    /// The Jacobian matches central differences of the right-hand side in every region, for
+    /// the rows of ξ and ξ' (the quadratures' rows are zero on purpose, see `jacobian`).
+    #[test]
+    fn jacobian_matches_finite_differences_in_every_region() {
+        let p = GearParams::paper();
+        let excitation = Excitation::Sine(Sine::new(300.0, 30.0, 84.0));
+        let xis = [-3e-6, -0.7e-6, -0.2e-6, 10e-6, p.G + 0.4e-6, p.G + 3e-6];
+        for xi in xis {
+            let rattle = Rattle::new(Dynamics::new(p), excitation, xi);
+            let y = [xi, 0.03, 0.0, 0.0, 0.0];
+            let j = rattle.jacobian(0.004, &y);
+            for (col, step) in [(XI, 1e-12), (XI_DOT, 1e-7)] {
+                let (mut up, mut down) = (y, y);
+                up[col] += step;
+                down[col] -= step;
+                let (fu, fd) = (rattle.rhs(0.004, &up), rattle.rhs(0.004, &down));
+                for row in [XI, XI_DOT] {
+                    let fd_slope = (fu[row] - fd[row]) / (2.0 * step);
+                    let err = (j[row][col] - fd_slope).abs();
+                    assert!(
+                        err <= 1e-5 * fd_slope.abs().max(1.0),
+                        "region {:?}, ∂f{row}/∂y{col}: {} vs {fd_slope}",
+                        rattle.region,
+                        j[row][col]
+                    );
+                }
+            }
+        }
     }
 }

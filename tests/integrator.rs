@@ -3,7 +3,7 @@
 //! and edge location (exact crossing times, each crossing counted once, grazes not skipped).
 
 use gear_rattle::integrator::dopri5;
-use gear_rattle::integrator::{Edge, Piecewise, Solver, System, Tolerance};
+use gear_rattle::integrator::{Edge, Jacobian, Method, Piecewise, Solver, System, Tolerance};
 
 /// y' = y cos t, y(0) = 1: y = exp(sin t).
 struct Exp;
@@ -11,6 +11,12 @@ struct Exp;
 impl System<1> for Exp {
     fn rhs(&self, t: f64, y: &[f64; 1]) -> [f64; 1] {
         [y[0] * t.cos()]
+    }
+}
+
+impl Jacobian<1> for Exp {
+    fn jacobian(&self, t: f64, _: &[f64; 1]) -> [[f64; 1]; 1] {
+        [[t.cos()]]
     }
 }
 
@@ -125,6 +131,12 @@ impl System<2> for TwoPieces {
     }
 }
 
+impl Jacobian<2> for TwoPieces {
+    fn jacobian(&self, _: f64, _: &[f64; 2]) -> [[f64; 2]; 2] {
+        [[0.0, 1.0], [0.0, 0.0]]
+    }
+}
+
 impl Piecewise<2> for TwoPieces {
     const GUARD: usize = 0;
     const RATE: usize = 1;
@@ -141,13 +153,20 @@ impl Piecewise<2> for TwoPieces {
     }
 }
 
-fn run(sys: &mut TwoPieces, y0: [f64; 2], t_end: f64, chunks: usize, tol: f64) -> Vec<(f64, Edge)> {
+fn run(
+    sys: &mut TwoPieces,
+    method: Method,
+    y0: [f64; 2],
+    t_end: f64,
+    chunks: usize,
+    tol: f64,
+) -> Vec<(f64, Edge)> {
     let tol = Tolerance {
         rtol: tol,
         atol: [tol, tol],
         controlled: 2,
     };
-    let mut solver = Solver::new(tol);
+    let mut solver = Solver::with_method(tol, method);
     let (mut t, mut y) = (0.0, y0);
     for k in 1..=chunks {
         solver
@@ -157,18 +176,24 @@ fn run(sys: &mut TwoPieces, y0: [f64; 2], t_end: f64, chunks: usize, tol: f64) -
     std::mem::take(&mut sys.crossings)
 }
 
+/// Both methods locate edges on their dense output (DOPRI5's and Radau IIA's).
+const METHODS: [Method; 2] = [Method::Explicit, Method::Implicit];
+
 /// x'' = −1 above 0 and +1 below, from x(0) = 1 at rest: crossings at t = (2k+1)√2.
 #[test]
 fn edges_are_located_exactly_and_crossed_once() {
-    for chunks in [1, 7, 1000] {
+    for (method, chunks) in METHODS
+        .into_iter()
+        .flat_map(|m| [(m, 1), (m, 7), (m, 1000)])
+    {
         let mut sys = TwoPieces::new(-1.0, 1.0);
-        let crossings = run(&mut sys, [1.0, 0.0], 20.0, chunks, 1e-8);
+        let crossings = run(&mut sys, method, [1.0, 0.0], 20.0, chunks, 1e-8);
         let expected: Vec<f64> = (0..7).map(|k| (2 * k + 1) as f64 * 2f64.sqrt()).collect();
         assert_eq!(crossings.len(), expected.len(), "{crossings:?}");
         for (k, ((t, edge), want)) in crossings.iter().zip(&expected).enumerate() {
             assert!(
                 (t - want).abs() < 1e-9,
-                "crossing {k} at {t}, expected {want}"
+                "{method:?}: crossing {k} at {t}, expected {want}"
             );
             let down = k % 2 == 0;
             assert_eq!(*edge, if down { Edge::Lower } else { Edge::Upper });
@@ -181,10 +206,12 @@ fn edges_are_located_exactly_and_crossed_once() {
 /// x = 1e-8 − 2e-4 t + t²/2, minimum −1e-8 at t = 2e-4, roots at 2e-4 ∓ √2·1e-4.
 #[test]
 fn a_graze_inside_one_step_is_not_skipped() {
-    let mut sys = TwoPieces::new(1.0, 1.0);
-    let crossings = run(&mut sys, [1e-8, -2e-4], 1.0, 1, 1e-3);
-    let roots = [2e-4 - 2f64.sqrt() * 1e-4, 2e-4 + 2f64.sqrt() * 1e-4];
-    assert_eq!(crossings.len(), 2, "{crossings:?}");
-    assert!((crossings[0].0 - roots[0]).abs() < 1e-9);
-    assert!((crossings[1].0 - roots[1]).abs() < 1e-9);
+    for method in METHODS {
+        let mut sys = TwoPieces::new(1.0, 1.0);
+        let crossings = run(&mut sys, method, [1e-8, -2e-4], 1.0, 1, 1e-3);
+        let roots = [2e-4 - 2f64.sqrt() * 1e-4, 2e-4 + 2f64.sqrt() * 1e-4];
+        assert_eq!(crossings.len(), 2, "{method:?}: {crossings:?}");
+        assert!((crossings[0].0 - roots[0]).abs() < 1e-9, "{method:?}");
+        assert!((crossings[1].0 - roots[1]).abs() < 1e-9, "{method:?}");
+    }
 }

@@ -7,7 +7,7 @@
 //! edges and rejected steps. This is what says which lever of issue 3 would pay.
 
 use super::*;
-use gear_rattle::integrator::{Edge, Piecewise, System};
+use gear_rattle::integrator::{Edge, Jacobian, Piecewise, System};
 use gear_rattle::physics::Region;
 use std::cell::Cell;
 
@@ -36,6 +36,12 @@ impl System<N> for Counted {
         e[index(self.inner.region)] += 1;
         self.evals.set(e);
         self.inner.rhs(t, y)
+    }
+}
+
+impl Jacobian<N> for Counted {
+    fn jacobian(&self, t: f64, y: &State) -> [[f64; N]; N] {
+        self.inner.jacobian(t, y)
     }
 }
 

@@ -444,6 +444,11 @@ impl Instance {
                     sim.rattle.impacts,
                     sim.solver.proposed_step(),
                 );
+                let method = if sim.solver.is_implicit() {
+                    "Radau IIA"
+                } else {
+                    "DOPRI5"
+                };
                 let new = [
                     impacts.count[0] - before.rattle.impacts.count[0],
                     impacts.count[1] - before.rattle.impacts.count[1],
@@ -456,13 +461,21 @@ impl Instance {
                         )
                     });
                 }
+                if stats.switches != before.solver.stats.switches {
+                    self.log(Status::Ok, EVENTS, || {
+                        format!("t = {t_end}: integration method handed over, now {method}")
+                    });
+                }
                 self.log(Status::Ok, STEPS, || {
                     format!(
-                        "t = {t_end}: {} accepted, {} rejected steps, {} edges, {} rhs evaluations in total; next step {:e} s",
+                        "t = {t_end}: {} accepted ({} by Radau IIA), {} rejected steps, {} edges, {} rhs evaluations, {} Jacobians, {} LU in total; next step {:e} s by {method}",
                         stats.accepted,
+                        stats.implicit_steps,
                         stats.rejected,
                         stats.edges,
                         stats.rhs_evals,
+                        stats.jacobians,
+                        stats.decompositions,
                         h_next
                     )
                 });

@@ -7,13 +7,25 @@ use serde::{Deserialize, Serialize};
 use super::error::{FmiError, FmiResult};
 use super::values::Values;
 use crate::contract::vr;
-use crate::integrator::{Piecewise, Solver, SolverError};
+use crate::integrator::{Method, Piecewise, Solver, SolverError};
 use crate::physics::{Dynamics, Excitation, GearParams, Polynomial, Shaft, Sine};
 use crate::rattle::{self, E_CONTACT, E_LUBRICANT, Rattle, State, XI, XI_DOT};
 
 /// Values of the `excitation` parameter.
 pub const EXCITATION_INPUTS: i64 = 0;
 pub const EXCITATION_SINE: i64 = 1;
+
+/// Values of the `solver` parameter.
+fn method(values: &Values) -> FmiResult<Method> {
+    match values.integer(vr::solver) {
+        0 => Ok(Method::Auto),
+        1 => Ok(Method::Explicit),
+        2 => Ok(Method::Implicit),
+        other => Err(FmiError::error(format!(
+            "parameter solver = {other} is invalid: allowed 0 (auto), 1 (DOPRI5) or 2 (Radau IIA)"
+        ))),
+    }
+}
 
 /// What moves the main shaft.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -106,7 +118,7 @@ impl Simulation {
         y[XI] = xi;
         y[XI_DOT] = xi_dot_start;
         Ok(Simulation {
-            solver: Solver::new(rattle.tolerance(rtol)),
+            solver: Solver::with_method(rattle.tolerance(rtol), method(values)?),
             rattle,
             t: t0,
             y,
@@ -182,6 +194,7 @@ impl Simulation {
             vr::solver_steps => self.solver.stats.accepted as f64,
             vr::solver_rejected => self.solver.stats.rejected as f64,
             vr::solver_rhs => self.solver.stats.rhs_evals as f64,
+            vr::solver_implicit_steps => self.solver.stats.implicit_steps as f64,
             _ => return None,
         })
     }
@@ -250,6 +263,13 @@ impl Simulation {
             vr::contact => self.rattle.region.flank() as i64,
             vr::impacts_Fplus => count[0] as i64,
             vr::impacts_Fminus => count[1] as i64,
+            vr::solver_method => {
+                if self.solver.is_implicit() {
+                    2
+                } else {
+                    1
+                }
+            }
             _ => return None,
         })
     }

@@ -4,8 +4,11 @@
 //!   Nørsett & Wanner, *Solving ODEs I*, II.5), one step at a time.
 //! - [`control`]: the error norm (atol + rtol·|y| per component) and the step-size controller.
 //! - [`roots`]: the Illinois root finder used to locate edges on the dense output.
-//! - [`solver`]: the driver that reaches an exact end time, carries the step size over from
-//!   one call to the next, and ends steps exactly on the edges of the system's pieces.
+//! - [`radau5`]: the Radau IIA method of order 5 for stiff phases, one step at a time.
+//! - [`stiffness`]: when to hand over from one method to the other.
+//! - [`solver`]: the driver that reaches an exact end time, carries the step size and method
+//!   over from one call to the next, and ends steps exactly on the edges of the system's
+//!   pieces.
 
 pub mod control;
 pub mod dopri5;
@@ -14,10 +17,15 @@ pub mod radau5;
 pub mod roots;
 pub mod serde_array;
 pub mod solver;
+pub mod stiffness;
+#[cfg(test)]
+mod test_systems;
+#[cfg(test)]
+mod tests;
 
 pub use control::Tolerance;
 pub use radau5::Jacobian;
-pub use solver::{Solver, SolverError, Stats};
+pub use solver::{Method, Solver, SolverError, Stats};
 
 /// An ODE y' = f(t, y) with N components.
 pub trait System<const N: usize> {

@@ -1,14 +1,21 @@
-//! The driver: advances a piecewise-smooth system to an exact end time with adaptive DOPRI5
-//! steps, ends steps exactly on the edges of the pieces (so no step straddles a kink), and
-//! keeps its step size and controller memory from one call to the next.
+//! The driver: advances a piecewise-smooth system to an exact end time with adaptive steps,
+//! ends steps exactly on the edges of the pieces (so no step straddles a kink), and keeps its
+//! step size, method and controllers' memory from one call to the next.
+//!
+//! The method is DOPRI5, or Radau IIA while the problem is stiff ([`Method::Auto`], the rule
+//! in `stiffness`), or either one throughout. Edges are located the same way on both methods'
+//! dense outputs. A non-stiff run pays for the implicit side only Hairer's stiffness
+//! estimate per accepted step (two weighted norms of the stages DOPRI5 has computed anyway).
 
 use super::control::{Controller, Tolerance};
 use super::dopri5::{self, EVALS_PER_STEP};
+use super::radau5::{Jacobian, RadauTrial, Stepper};
 use super::roots::illinois;
+use super::stiffness::{Switch, spectral_radius, stiffness};
 use super::{Dense, Edge, Piecewise};
 use serde::{Deserialize, Serialize};
 
-/// Work counters, as DOPRI5 reports them.
+/// Work counters.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Stats {
     pub rhs_evals: u64,
@@ -16,6 +23,13 @@ pub struct Stats {
     pub rejected: u64,
     /// Edges crossed (each costs one extra step, ending exactly on the edge).
     pub edges: u64,
+    /// Accepted steps taken by Radau IIA (the others by DOPRI5).
+    pub implicit_steps: u64,
+    /// Jacobians evaluated and LU decompositions (pairs) made by Radau IIA.
+    pub jacobians: u64,
+    pub decompositions: u64,
+    /// Hand-overs between DOPRI5 and Radau IIA.
+    pub switches: u64,
 }
 
 /// Why the solver stopped short of the end time. The state is left at the last good point.
@@ -54,16 +68,56 @@ impl std::fmt::Display for SolverError {
 /// Edge crossings allowed at one instant before the solver gives up.
 const MAX_CROSSINGS_AT_ONCE: u32 = 8;
 
-/// Adaptive DOPRI5 with edge location; all of its state is plain data (copyable).
+/// Which method steps (the FMU's `solver` parameter).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Method {
+    /// DOPRI5, handing over to Radau IIA while the problem is stiff.
+    #[default]
+    Auto,
+    /// DOPRI5 throughout.
+    Explicit,
+    /// Radau IIA throughout.
+    Implicit,
+}
+
+/// An accepted step, whichever method took it.
+struct Accepted<const N: usize> {
+    y1: [f64; N],
+    /// f(t + h, y1) when the method has it (DOPRI5's last stage).
+    k_end: Option<[f64; N]>,
+    h_next: f64,
+    /// The edge the step leaves its piece through, and at which fraction of the step.
+    edge: Option<(Edge, f64)>,
+    /// DOPRI5's stiffness estimate h·ρ of the step (0 when not asked for).
+    h_rho: f64,
+}
+
+/// Where a step starts: t, y and f(t, y).
+#[derive(Clone, Copy)]
+struct Start<'a, const N: usize> {
+    t: f64,
+    y: &'a [f64; N],
+    k1: &'a [f64; N],
+}
+
+/// Adaptive DOPRI5 / Radau IIA with edge location; all of its state is plain data (copyable).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Solver<const N: usize> {
-    pub tol: Tolerance<N>,
+    tol: Tolerance<N>,
     /// Most steps one `advance` may take.
     pub max_steps: u64,
     pub stats: Stats,
+    method: Method,
+    /// Radau IIA is stepping now.
+    implicit: bool,
     /// Step size proposed for the next step (0: not chosen yet).
     h: f64,
     controller: Controller,
+    stepper: Stepper<N>,
+    switch: Switch,
+    /// Spectral radius of Radau's latest Jacobian, and that Jacobian's number.
+    rho: f64,
+    rho_of: u64,
     /// f(t, y) at the current point (first stage of the next step), when `k1_valid`.
     #[serde(with = "super::serde_array")]
     k1: [f64; N],
@@ -74,24 +128,45 @@ pub struct Solver<const N: usize> {
 }
 
 impl<const N: usize> Solver<N> {
+    /// A solver choosing its method by itself ([`Method::Auto`]).
     pub fn new(tol: Tolerance<N>) -> Self {
+        Self::with_method(tol, Method::Auto)
+    }
+
+    pub fn with_method(tol: Tolerance<N>, method: Method) -> Self {
         Solver {
             tol,
             max_steps: 10_000_000,
             stats: Stats::default(),
+            method,
+            implicit: method == Method::Implicit,
             h: 0.0,
             controller: Controller::default(),
+            stepper: Stepper::new(tol),
+            switch: Switch::default(),
+            rho: 0.0,
+            rho_of: 0,
             k1: [0.0; N],
             k1_valid: false,
             just_crossed: false,
         }
     }
 
+    pub fn tolerance(&self) -> &Tolerance<N> {
+        &self.tol
+    }
+
+    /// True while Radau IIA steps.
+    pub fn is_implicit(&self) -> bool {
+        self.implicit
+    }
+
     /// To be called when the system or the state changed from outside (new inputs, a jump):
-    /// the stored derivative no longer holds.
+    /// the stored derivative, Jacobian and extrapolations no longer hold.
     pub fn invalidate(&mut self) {
         self.k1_valid = false;
         self.just_crossed = false;
+        self.stepper.invalidate();
     }
 
     /// Step size the next step will try.
@@ -109,7 +184,7 @@ impl<const N: usize> Solver<N> {
     }
 
     /// Advances (t, y) to `t_end` exactly.
-    pub fn advance<S: Piecewise<N>>(
+    pub fn advance<S: Piecewise<N> + Jacobian<N>>(
         &mut self,
         sys: &mut S,
         t: &mut f64,
@@ -139,26 +214,26 @@ impl<const N: usize> Solver<N> {
                     steps: self.max_steps,
                 });
             }
-            let trial = dopri5::step(sys, *t, y, &k1, h);
-            self.stats.rhs_evals += EVALS_PER_STEP;
-            let verdict = self
-                .controller
-                .judge(self.tol.norm(&trial.y0, &trial.y1, &trial.err), h);
-            if !verdict.accept {
-                self.stats.rejected += 1;
-                self.h = verdict.h_next;
-                continue;
-            }
+            let start = Start { t: *t, y, k1: &k1 };
+            let step = match self.attempt(sys, start, h) {
+                Ok(step) => step,
+                Err(h_next) => {
+                    self.stats.rejected += 1;
+                    self.h = h_next;
+                    continue;
+                }
+            };
             self.stats.accepted += 1;
-            let (lo, hi) = sys.piece();
-            if let Some((edge, theta)) = locate_edge(&trial, (S::GUARD, S::RATE), lo, hi) {
+            if let Some((edge, theta)) = step.edge {
                 // Redo the step so that it ends on the edge, then cross it. The state is kept
                 // as the step gives it (not moved onto the edge: where the force is not zero
                 // there, that would add or remove energy at every crossing).
                 if theta > 0.0 {
-                    let redo = dopri5::step(sys, *t, y, &k1, theta * h);
-                    self.stats.rhs_evals += EVALS_PER_STEP;
-                    *y = redo.y1;
+                    let Some(y_edge) = self.redo(sys, start, theta * h) else {
+                        self.h = 0.5 * theta * h;
+                        continue;
+                    };
+                    *y = y_edge;
                     *t += theta * h;
                     crossings_here = 0;
                 } else {
@@ -170,24 +245,132 @@ impl<const N: usize> Solver<N> {
                 sys.cross(edge, *t, y);
                 self.stats.edges += 1;
                 self.k1_valid = false;
+                self.stepper.invalidate();
                 self.just_crossed = true;
-                self.h = verdict.h_next.max(theta * h);
+                self.h = step.h_next.max(theta * h);
                 continue;
             }
             crossings_here = 0;
             self.just_crossed = false;
             *t = if last { t_end } else { *t + h };
-            *y = trial.y1;
-            self.k1 = *trial.k_end();
-            self.k1_valid = true;
+            *y = step.y1;
+            match step.k_end {
+                Some(k) => self.k1 = k,
+                None => self.k1_valid = false,
+            }
             // A step cut short to land on t_end says little about the natural step size.
             self.h = if last {
-                verdict.h_next.max(self.h)
+                step.h_next.max(self.h)
             } else {
-                verdict.h_next
+                step.h_next
             };
+            if self.implicit {
+                self.stats.implicit_steps += 1;
+            }
+            self.hand_over(step.h_rho);
         }
         Ok(())
+    }
+
+    /// One step of size h from (t, y) with the current method: accepted (with the edge it
+    /// leaves its piece through, if any) or rejected with the step size to retry with.
+    fn attempt<S: Piecewise<N> + Jacobian<N>>(
+        &mut self,
+        sys: &S,
+        at: Start<N>,
+        h: f64,
+    ) -> Result<Accepted<N>, f64> {
+        let (lo, hi) = sys.piece();
+        let guard = (S::GUARD, S::RATE);
+        if self.implicit {
+            let trial = self.implicit_step(sys, at, h);
+            let verdict = self.stepper.judge(&trial);
+            if !verdict.accept {
+                return Err(verdict.h_next);
+            }
+            Ok(Accepted {
+                y1: trial.y1,
+                k_end: None,
+                h_next: verdict.h_next,
+                edge: locate_edge(&trial, guard, lo, hi),
+                h_rho: 0.0,
+            })
+        } else {
+            let trial = dopri5::step(sys, at.t, at.y, at.k1, h);
+            self.stats.rhs_evals += EVALS_PER_STEP;
+            let verdict = self
+                .controller
+                .judge(self.tol.norm(&trial.y0, &trial.y1, &trial.err), h);
+            if !verdict.accept {
+                return Err(verdict.h_next);
+            }
+            Ok(Accepted {
+                y1: trial.y1,
+                k_end: Some(*trial.k_end()),
+                h_next: verdict.h_next,
+                edge: locate_edge(&trial, guard, lo, hi),
+                h_rho: if self.method == Method::Auto {
+                    stiffness(&trial, &self.tol)
+                } else {
+                    0.0
+                },
+            })
+        }
+    }
+
+    /// The step redone with size h to end on an edge; None if Radau's Newton iteration fails
+    /// on it.
+    fn redo<S: Piecewise<N> + Jacobian<N>>(
+        &mut self,
+        sys: &S,
+        at: Start<N>,
+        h: f64,
+    ) -> Option<[f64; N]> {
+        if self.implicit {
+            let trial = self.implicit_step(sys, at, h);
+            trial.converged().then_some(trial.y1)
+        } else {
+            self.stats.rhs_evals += EVALS_PER_STEP;
+            Some(dopri5::step(sys, at.t, at.y, at.k1, h).y1)
+        }
+    }
+
+    /// A Radau IIA trial, with its work counted and the spectral radius of a new Jacobian
+    /// taken (once per Jacobian: it is what the way back to DOPRI5 is judged by).
+    fn implicit_step<S: Jacobian<N>>(&mut self, sys: &S, at: Start<N>, h: f64) -> RadauTrial<N> {
+        let before = self.stepper.stats;
+        let trial = self.stepper.step(sys, at.t, at.y, at.k1, h);
+        let after = self.stepper.stats;
+        self.stats.rhs_evals += after.rhs_evals - before.rhs_evals;
+        self.stats.jacobians += after.jacobians - before.jacobians;
+        self.stats.decompositions += after.decompositions - before.decompositions;
+        if after.jacobians != self.rho_of
+            && let Some(j) = self.stepper.jacobian()
+        {
+            self.rho = spectral_radius(j);
+            self.rho_of = after.jacobians;
+        }
+        trial
+    }
+
+    /// After an accepted step that did not cross an edge: the hand-over of [`Method::Auto`].
+    /// To Radau IIA (afresh) when DOPRI5 has been held back by stability; back to DOPRI5 (a
+    /// fresh controller, Radau's step size) when Radau's steps are within DOPRI5's stability.
+    fn hand_over(&mut self, explicit_h_rho: f64) {
+        if self.method != Method::Auto {
+            return;
+        }
+        if self.implicit {
+            if self.switch.to_explicit(self.h * self.rho) {
+                self.implicit = false;
+                self.controller = Controller::default();
+                self.stats.switches += 1;
+            }
+        } else if self.switch.to_implicit(explicit_h_rho) {
+            self.implicit = true;
+            self.stepper.invalidate();
+            self.stats.switches += 1;
+        }
     }
 
     /// Hairer's starting step: from the sizes of y, f and an estimate of f', capped.

@@ -38,6 +38,9 @@ OUTPUTS = [
     "theta_M_out",
     "omega_M_out",
     "alpha_M_out",
+    "solver_method",
+    "solver_rhs",
+    "solver_implicit_steps",
 ]
 
 

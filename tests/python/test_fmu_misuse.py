@@ -332,6 +332,8 @@ def test_invalid_parameter_refused(slave, name, value):
         ({"excitation": 2}, {}, "excitation"),
         ({"excitation": -1}, {}, "excitation"),
         ({"excitation": 1}, {"f_exc": 0.0}, "f_exc"),
+        ({"solver": 3}, {}, "solver"),
+        ({"solver": -1}, {}, "solver"),
     ],
 )
 def test_invalid_excitation_refused(slave, integers, reals, named):

@@ -1,0 +1,187 @@
+//! When a problem is stiff for DOPRI5, and when it no longer is: the rule of [`Method::Auto`]
+//! (see `solver`).
+//!
+//! - explicit → implicit: Hairer's DOPRI5 estimate of h·ρ from its last two stages
+//!   ([`stiffness`]), stiff after 15 accepted steps above a threshold ([`StiffnessDetector`];
+//!   the estimate weighed by the tolerance scales and the threshold lowered from 3.25 to 2,
+//!   see [`STIFF_H_RHO`]);
+//! - implicit → explicit: h·ρ(J) with the spectral radius of Radau's Jacobian
+//!   ([`spectral_radius`]) and the step size Radau proposes, at most the same threshold on 15
+//!   accepted steps in a row: DOPRI5 could then take those steps stably.
+//!
+//! [`Method::Auto`]: super::solver::Method::Auto
+
+use nalgebra::DMatrix;
+use serde::{Deserialize, Serialize};
+
+use super::control::Tolerance;
+use super::dopri5;
+
+/// Spectral radius max |λ| of a Jacobian (Schur decomposition; infinite if J is not finite).
+/// With the step size h of the implicit method, h·ρ(J) tells whether DOPRI5 could take that
+/// step stably (its stability interval on the negative real axis is about [−3.3, 0]).
+pub fn spectral_radius<const N: usize>(j: &[[f64; N]; N]) -> f64 {
+    if j.iter().flatten().any(|v| !v.is_finite()) {
+        return f64::INFINITY;
+    }
+    DMatrix::from_fn(N, N, |r, c| j[r][c])
+        .complex_eigenvalues()
+        .iter()
+        .map(|l| l.norm())
+        .fold(0.0, f64::max)
+}
+
+/// Hairer's stiffness estimate from an explicit DOPRI5 step: h·ρ ≈ h·‖k7 − k6‖ / ‖y1 − y6‖
+/// (both stages at t + h), in the tolerance's weighted norm over its controlled components.
+/// Hairer's DOPRI5 takes the plain Euclidean norm; with components of unlike units (a
+/// position and a velocity) that estimate sees the singular values of J rather than its
+/// eigenvalues (from 1 to k for x'' = −k x) and missed a resting stiff contact entirely;
+/// weighed by the tolerance scales (atol of a velocity = atol of the position × the contact
+/// frequency, as `Rattle::tolerance` sets them) it sees |λ|. 0 when y1 = y6.
+pub fn stiffness<const N: usize>(trial: &dopri5::Trial<N>, tol: &Tolerance<N>) -> f64 {
+    let (y6, k6) = trial.stage6();
+    let k7 = trial.k_end();
+    let (mut num, mut den) = (0.0, 0.0);
+    for i in 0..tol.controlled {
+        let scale = tol.atol[i] + tol.rtol * trial.y0[i].abs().max(trial.y1[i].abs());
+        num += ((k7[i] - k6[i]) / scale).powi(2);
+        den += ((trial.y1[i] - y6[i]) / scale).powi(2);
+    }
+    if den > 0.0 {
+        trial.h * (num / den).sqrt()
+    } else {
+        0.0
+    }
+}
+
+/// The threshold of h·ρ, both ways. Hairer's DOPRI5 takes 3.25, the radius of DOPRI5's
+/// stability domain on the negative real axis (3.3); but the radius shrinks towards the imaginary axis: 3.3 for real eigenvalues, 3.0 for a contact
+/// mode with damping ratio ζ = 0.2 (where DOPRI5's steps were measured to hover at
+/// h·|λ| = 3.0 ± 0.6 on a resting contact, so that 3.25 never fired), 2.6 for ζ = 0.09,
+/// 2.3 for ζ = 0.035. An accepted step with h·|λ| > 2 leaves that mode an error of about
+/// (h·|λ|)⁶/720 ≈ 9 % of its amplitude per step: it is accepted only when the mode has died
+/// out, which is what stiffness means.
+pub const STIFF_H_RHO: f64 = 2.0;
+/// Stiff verdicts (not interrupted by 6 non-stiff ones in a row) that make a problem stiff.
+pub const STIFF_STEPS: u32 = 15;
+const CALM_STEPS: u32 = 6;
+
+/// Hairer's DOPRI5 switching rule, fed with [`stiffness`] of each accepted step: stiff after
+/// 15 verdicts h·ρ > [`STIFF_H_RHO`], the count restarting after 6 non-stiff verdicts in a
+/// row.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct StiffnessDetector {
+    stiff: u32,
+    calm: u32,
+}
+
+impl StiffnessDetector {
+    /// Records one accepted step's h·ρ; true when the problem is now judged stiff.
+    pub fn observe(&mut self, h_rho: f64) -> bool {
+        if h_rho > STIFF_H_RHO {
+            self.calm = 0;
+            self.stiff += 1;
+            self.stiff >= STIFF_STEPS
+        } else {
+            self.calm += 1;
+            if self.calm >= CALM_STEPS {
+                self.stiff = 0;
+            }
+            false
+        }
+    }
+}
+
+/// Both directions of the hand-over, with their memories (part of the solver's state).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Switch {
+    detector: StiffnessDetector,
+    /// Accepted implicit steps in a row that DOPRI5 could have taken stably.
+    calm: u32,
+}
+
+impl Switch {
+    /// After an accepted DOPRI5 step with its [`stiffness`] estimate: true to go implicit.
+    pub fn to_implicit(&mut self, h_rho: f64) -> bool {
+        let stiff = self.detector.observe(h_rho);
+        if stiff {
+            *self = Switch::default();
+        }
+        stiff
+    }
+
+    /// After an accepted Radau IIA step, with h·ρ(J) for the step size it proposes next:
+    /// true to go back to DOPRI5.
+    pub fn to_explicit(&mut self, h_rho: f64) -> bool {
+        self.calm = if h_rho <= STIFF_H_RHO {
+            self.calm + 1
+        } else {
+            0
+        };
+        let calm = self.calm >= STIFF_STEPS;
+        if calm {
+            *self = Switch::default();
+        }
+        calm
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::integrator::System;
+    use crate::integrator::control::Controller;
+    use crate::integrator::test_systems::{Linear, tolerance};
+
+    #[test]
+    fn stiffness_estimate_of_dopri5() {
+        // Scalar y' = λ y: k7 − k6 = λ (y1 − y6) exactly.
+        struct Scalar(f64);
+        impl System<1> for Scalar {
+            fn rhs(&self, _: f64, y: &[f64; 1]) -> [f64; 1] {
+                [self.0 * y[0]]
+            }
+        }
+        let trial = dopri5::step(&Scalar(-300.0), 0.0, &[1.0], &[-300.0], 0.01);
+        assert!((stiffness(&trial, &tolerance(1e-6, [1e-6])) - 3.0).abs() < 1e-12);
+
+        // The stiff linear system under DOPRI5 with its own controller: once the fast mode has
+        // died out the steps hover at the stability limit and the detector fires.
+        let tol = tolerance(1e-6, [1e-6; 2]);
+        let mut controller = Controller::default();
+        let mut detector = StiffnessDetector::default();
+        let (mut t, mut y, mut h) = (0.0, [1.0, 0.0], 1e-7);
+        let mut k1 = Linear.rhs(t, &y);
+        let mut accepted = 0;
+        let mut fired_at = None;
+        while t < 1e-3 && fired_at.is_none() {
+            let trial = dopri5::step(&Linear, t, &y, &k1, h);
+            let verdict = controller.judge(tol.norm(&trial.y0, &trial.y1, &trial.err), h);
+            if verdict.accept {
+                accepted += 1;
+                t += h;
+                y = trial.y1;
+                k1 = *trial.k_end();
+                if detector.observe(stiffness(&trial, &tol)) {
+                    fired_at = Some((t, accepted, stiffness(&trial, &tol)));
+                }
+            }
+            h = verdict.h_next;
+        }
+        println!("DOPRI5 on λ = −1, −1e6: judged stiff at (t, steps, h·ρ) = {fired_at:?}");
+        let (t, steps, h_rho) = fired_at.expect("stiffness not detected");
+        assert!(t < 1e-4 && steps < 100, "{t} {steps}");
+        assert!((2.0..4.0).contains(&h_rho));
+    }
+
+    #[test]
+    fn spectral_radius_of_a_contact_jacobian() {
+        let k: f64 = 1e10;
+        let c = 0.4 * k.sqrt();
+        let rho = spectral_radius(&[[0.0, 1.0], [-k, -c]]);
+        assert!((rho / k.sqrt() - 1.0).abs() < 1e-12, "{rho}");
+        let rho = spectral_radius(&Linear::A);
+        assert!((rho / 1e6 - 1.0).abs() < 1e-9, "{rho}");
+        assert_eq!(spectral_radius(&[[f64::NAN]]), f64::INFINITY);
+    }
+}
