@@ -157,6 +157,11 @@ def main() -> int:
     if failing:
         w("")
         w("Failing: " + "; ".join(f"**{c.name}** ({v.outcome}{', ' + v.measure + ' = ' + fmt(v.error, '.2g') + ' > ' + sci(v.bound) if math.isfinite(v.error) else ''})" for c, v in failing) + ".")
+        known = [(c.name, S.KNOWN_SHORT[c.name]) for c, _ in failing if c.name in S.KNOWN_SHORT]
+        if known:
+            w("")
+            w("Known shortfalls (strict xfails in `make test`, reported on issue 4): "
+              + "; ".join(f"**{name}**: {why}" for name, why in known) + ".")
     w("")
     w("## How each case is judged")
     w("")

@@ -111,6 +111,10 @@ impl Piecewise<N> for Rattle {
         self.dynamics.law.bounds(self.region)
     }
 
+    fn rough_start(&self) -> bool {
+        self.dynamics.law.rough_at_onset(self.region)
+    }
+
     fn cross(&mut self, edge: Edge, _t: f64, y: &State) {
         let law = &self.dynamics.law;
         let next = match edge {

@@ -60,6 +60,13 @@ pub trait Piecewise<const N: usize>: System<N> {
     /// Switches to the neighbouring piece through `edge` at time t and state y.
     fn cross(&mut self, edge: Edge, t: f64, y: &[f64; N]);
 
+    /// Whether the right-hand side of the current piece is rough where the piece begins (a
+    /// non-integer power below 3 of the distance to its edge): the solution is then not
+    /// smooth at the start of the first step, whose error estimate the solver distrusts.
+    fn rough_start(&self) -> bool {
+        false
+    }
+
     /// Moves to the piece that contains `y[GUARD]` through each edge on the way (after a
     /// jump of the state from outside the integrator); returns how many edges were crossed.
     fn settle(&mut self, t: f64, y: &[f64; N]) -> usize {

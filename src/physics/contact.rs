@@ -104,6 +104,20 @@ impl ContactLaw {
         }
     }
 
+    /// Whether the force of `region` starts, where the region borders the gap, as a
+    /// non-integer power below 3 of the penetration: a contact entered without a smoothing
+    /// band (ε = 0) with α not an integer. Inside a band s ∝ δ² makes it δ^(α+2), and a
+    /// contact entered from its band starts at δ = ∓ε, away from the singular point.
+    pub fn rough_at_onset(&self, region: Region) -> bool {
+        let contact = matches!(region, Region::ContactPlus | Region::ContactMinus);
+        let rough_power = match self.power {
+            Power::One => false,
+            Power::FourThirds | Power::ThreeHalves => true,
+            Power::General(exponent) => (exponent + 1.0).fract() != 0.0 && exponent < 2.0,
+        };
+        contact && self.epsilon == 0.0 && rough_power
+    }
+
     /// The region that contains ξ (the gap taken closed, [0, G]).
     pub fn classify(&self, xi: f64) -> Region {
         let banded = self.epsilon > 0.0;
@@ -290,6 +304,29 @@ mod tests {
                 );
                 assert!((slopes.d_xi_dot - d_v).abs() <= 1e-6 * d_v.abs().max(1.0));
             }
+        }
+    }
+
+    /// Rough onsets: contacts without a band whose law is a non-integer power below 3.
+    #[test]
+    fn rough_onsets_are_contacts_without_band_and_non_integer_powers() {
+        let rough = |epsilon: f64, alpha: f64, region: Region| {
+            ContactLaw::new(&GearParams {
+                epsilon,
+                alpha,
+                ..GearParams::paper()
+            })
+            .rough_at_onset(region)
+        };
+        for alpha in [10.0 / 9.0, 4.0 / 3.0, 1.5, 2.5] {
+            assert!(rough(0.0, alpha, Region::ContactPlus), "{alpha}");
+            assert!(rough(0.0, alpha, Region::ContactMinus), "{alpha}");
+            assert!(!rough(1e-6, alpha, Region::ContactPlus), "{alpha}");
+            assert!(!rough(1e-6, alpha, Region::BandPlus), "{alpha}");
+            assert!(!rough(0.0, alpha, Region::Gap), "{alpha}");
+        }
+        for alpha in [1.0, 2.0, 3.5] {
+            assert!(!rough(0.0, alpha, Region::ContactPlus), "{alpha}");
         }
     }
 

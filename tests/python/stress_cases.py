@@ -68,6 +68,17 @@ HOUR = 3600.0
 # ---------------------------------------------------------------------------------------
 
 
+# Cases where the FMU's error is above 10 x rtol today (measured at rtol 1e-8, 12 ms): a known
+# shortfall, reported on issue 4, not hidden. strict: the day one of them passes, the marker
+# must go. (ε = 0 left this list when the first step into a contact without a band was made
+# to meet 1/20 of the tolerance, see solver.rs FIRST_STEP_DISTRUST.)
+KNOWN_SHORT = {
+    "K* 1e8": "12 x rtol after two impacts at rtol 1e-8; 5.3, 8.5, 12, 8.4, 7.6 x at rtol 1e-6 ... 1e-10: "
+    "proportional to rtol, the per-step errors adding up",
+    "energy free rattling": "energy off by 15 x rtol after 8 impacts: 1.9 rtol lost per impact, the per-step "
+    "tolerance on xi' adding up over the steps of each contact",
+}
+
 @dataclass(frozen=True)
 class Case:
     name: str

@@ -21,14 +21,6 @@ import stress_cases as S
 
 NEEDS_SWITCHING = "needs the implicit switching of issue 4"
 
-# Cases where the FMU's error is above 10 x rtol today (measured at rtol 1e-8, 12 ms, after
-# the no-snap and xi' weight fixes): a known shortfall, reported on issue 4, not hidden.
-# strict: the day one of them passes, the marker must go.
-KNOWN_SHORT = {
-    "eps 0": "contact entered without a band with alpha = 4/3: 46 x rtol at the first impacts",
-    "K* 1e8": "12 x rtol after two impacts",
-    "energy free rattling": "energy off by 15 x rtol over 8 impacts with the smoothing band",
-}
 
 
 @pytest.fixture(scope="session")
@@ -53,8 +45,8 @@ def results():
 def test_stress(case, driver, results, record_property, request):
     if case.needs_switching and not driver.has_switching:
         request.node.add_marker(pytest.mark.xfail(strict=False, reason=NEEDS_SWITCHING))
-    if case.name in KNOWN_SHORT:
-        request.node.add_marker(pytest.mark.xfail(strict=True, reason=KNOWN_SHORT[case.name]))
+    if case.name in S.KNOWN_SHORT:
+        request.node.add_marker(pytest.mark.xfail(strict=True, reason=S.KNOWN_SHORT[case.name]))
     v = S.evaluate(case, driver)
     r = v.run
     row = {
