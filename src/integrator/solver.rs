@@ -237,6 +237,9 @@ impl<const N: usize> Solver<N> {
                 }
             };
             self.stats.accepted += 1;
+            if self.implicit {
+                self.stats.implicit_steps += 1;
+            }
             if let Some((edge, theta)) = step.edge {
                 // Redo the step so that it ends on the edge, then cross it. The state is kept
                 // as the step gives it (not moved onto the edge: where the force is not zero
@@ -277,9 +280,6 @@ impl<const N: usize> Solver<N> {
             } else {
                 step.h_next
             };
-            if self.implicit {
-                self.stats.implicit_steps += 1;
-            }
             self.hand_over(step.h_rho);
         }
         Ok(())
