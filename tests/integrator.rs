@@ -68,13 +68,14 @@ fn the_step_is_fifth_order_and_the_dense_output_fourth() {
     }
 }
 
-fn adaptive(rtol: f64, chunks: usize) -> (f64, u64) {
+fn adaptive(rtol: f64, chunks: usize, interpolate_ends: bool) -> (f64, u64) {
     let tol = Tolerance {
         rtol,
         atol: [rtol],
         controlled: 1,
     };
     let mut solver = Solver::new(tol);
+    solver.interpolate_ends = interpolate_ends;
     let (mut t, mut y) = (0.0, [1.0]);
     let t_end = 20.0;
     for k in 1..=chunks {
@@ -88,8 +89,8 @@ fn adaptive(rtol: f64, chunks: usize) -> (f64, u64) {
 
 #[test]
 fn the_error_follows_the_tolerance() {
-    let (e6, _) = adaptive(1e-6, 1);
-    let (e9, _) = adaptive(1e-9, 1);
+    let (e6, _) = adaptive(1e-6, 1, false);
+    let (e9, _) = adaptive(1e-9, 1, false);
     assert!(e6 < 1e-4 && e9 < 1e-7, "{e6:e} {e9:e}");
     assert!(e6 / e9 > 100.0, "1e-6 → {e6:e}, 1e-9 → {e9:e}");
 }
@@ -98,13 +99,30 @@ fn the_error_follows_the_tolerance() {
 /// the controller carry over, nothing restarts.
 #[test]
 fn the_step_size_carries_over_between_calls() {
-    let (e1, one_call) = adaptive(1e-10, 1);
-    let (e100, hundred_calls) = adaptive(1e-10, 100);
+    let (e1, one_call) = adaptive(1e-10, 1, false);
+    let (e100, hundred_calls) = adaptive(1e-10, 100, false);
     assert!(
         (hundred_calls as f64) < 1.3 * one_call as f64 + 6.0 * 100.0,
         "{hundred_calls} vs {one_call} evaluations"
     );
     assert!(e100 < 10.0 * e1.max(1e-12), "{e100:e} vs {e1:e}");
+}
+
+/// With end times served from the dense output, 20 000 calls (one per millisecond) cost
+/// the right-hand sides of one call (but for the first step, whose size is capped by the
+/// first call's length and grows back from there), and each end is as accurate as the steps
+/// around it.
+#[test]
+fn interpolated_ends_cost_nothing_and_keep_the_accuracy() {
+    let (e1, one_call) = adaptive(1e-8, 1, true);
+    let (e_many, many_calls) = adaptive(1e-8, 20_000, true);
+    let (_, cut_short) = adaptive(1e-8, 20_000, false);
+    println!(
+        "1 call: {one_call} rhs; 20 000 calls: {many_calls} interpolated, {cut_short} cut short"
+    );
+    assert!(many_calls <= one_call + 30, "{many_calls} vs {one_call}");
+    assert!(cut_short > 10 * many_calls);
+    assert!(e_many < 1e-6 && e1 < 1e-6, "{e_many:e} {e1:e}");
 }
 
 /// x'' = a_above while x ≥ 0 and a_below while x ≤ 0: piecewise quadratic exact solutions,

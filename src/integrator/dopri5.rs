@@ -2,6 +2,8 @@
 //! DOPRI5: the 5th-order solution is propagated, the embedded 4th-order one gives the error
 //! estimate, and a continuous extension of order 4 interpolates inside the step.
 
+use serde::{Deserialize, Serialize};
+
 use super::{Dense, System};
 
 const C2: f64 = 1.0 / 5.0;
@@ -46,17 +48,24 @@ const D7: f64 = 69997945.0 / 29380423.0;
 /// Number of right-hand-side evaluations per step (the 7th is reused as the next k1).
 pub const EVALS_PER_STEP: u64 = 6;
 
-/// A step taken from (t, y0) with size h, not yet accepted.
+/// A step taken from (t, y0) with size h, not yet accepted. Plain data: a step taken past a
+/// communication point is kept in the solver's state (and the FMU state) for its dense output.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Trial<const N: usize> {
     pub h: f64,
+    #[serde(with = "super::serde_array")]
     pub y0: [f64; N],
+    #[serde(with = "super::serde_array")]
     pub y1: [f64; N],
     /// Local error estimate per component.
+    #[serde(with = "super::serde_array")]
     pub err: [f64; N],
     /// f(t, y0) and the stages needed by the dense output; k7 = f(t + h, y1).
+    #[serde(with = "super::serde_array::rows")]
     k: [[f64; N]; 6],
     /// The argument of the 6th stage (at t + h, like k7): Hairer's stiffness estimate
     /// compares k7 − k6 with y1 − y6.
+    #[serde(with = "super::serde_array")]
     y6: [f64; N],
 }
 

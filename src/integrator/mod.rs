@@ -41,7 +41,7 @@ pub trait Dense<const N: usize> {
 }
 
 /// Which edge of the current piece a trajectory leaves through.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum Edge {
     Lower,
     Upper,

@@ -175,7 +175,7 @@ struct Jac<const N: usize> {
     t: f64,
     #[serde(with = "super::serde_array")]
     y: [f64; N],
-    #[serde(with = "rows")]
+    #[serde(with = "super::serde_array::rows")]
     m: [[f64; N]; N],
 }
 
@@ -214,39 +214,8 @@ struct Accepted<const N: usize> {
     #[serde(with = "super::serde_array")]
     y1: [f64; N],
     h: f64,
-    #[serde(with = "rows")]
+    #[serde(with = "super::serde_array::rows")]
     cont: [[f64; N]; 3],
-}
-
-/// serde for `[[f64; N]; M]` (rows of `serde_array`), as M·N numbers.
-mod rows {
-    use serde::de::Error;
-    use serde::{Deserialize, Deserializer, Serialize, Serializer};
-
-    pub fn serialize<S: Serializer, const N: usize, const M: usize>(
-        a: &[[f64; N]; M],
-        s: S,
-    ) -> Result<S::Ok, S::Error> {
-        a.iter()
-            .flatten()
-            .copied()
-            .collect::<Vec<f64>>()
-            .serialize(s)
-    }
-
-    pub fn deserialize<'de, D: Deserializer<'de>, const N: usize, const M: usize>(
-        d: D,
-    ) -> Result<[[f64; N]; M], D::Error> {
-        let v = Vec::<f64>::deserialize(d)?;
-        if v.len() != N * M {
-            return Err(D::Error::invalid_length(v.len(), &"M·N numbers"));
-        }
-        let mut a = [[0.0; N]; M];
-        for (k, x) in v.into_iter().enumerate() {
-            a[k / N][k % N] = x;
-        }
-        Ok(a)
-    }
 }
 
 /// Radau IIA stepper: the Jacobian and LU caches, the Newton and step-size controllers'

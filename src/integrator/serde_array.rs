@@ -1,5 +1,6 @@
 //! serde for `[f64; N]` with a const-generic N (serde's own impls cover fixed sizes only),
-//! used as `#[serde(with = "serde_array")]` on the solver's arrays.
+//! used as `#[serde(with = "serde_array")]` on the solver's arrays, and for `[[f64; N]; M]`
+//! (`serde_array::rows`).
 
 use serde::de::{Error, SeqAccess, Visitor};
 use serde::ser::SerializeTuple;
@@ -32,4 +33,35 @@ pub fn deserialize<'de, D: Deserializer<'de>, const N: usize>(d: D) -> Result<[f
         }
     }
     d.deserialize_tuple(N, Numbers::<N>)
+}
+
+/// serde for `[[f64; N]; M]` (rows of `serde_array`), as M·N numbers.
+pub mod rows {
+    use serde::de::Error;
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+    pub fn serialize<S: Serializer, const N: usize, const M: usize>(
+        a: &[[f64; N]; M],
+        s: S,
+    ) -> Result<S::Ok, S::Error> {
+        a.iter()
+            .flatten()
+            .copied()
+            .collect::<Vec<f64>>()
+            .serialize(s)
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>, const N: usize, const M: usize>(
+        d: D,
+    ) -> Result<[[f64; N]; M], D::Error> {
+        let v = Vec::<f64>::deserialize(d)?;
+        if v.len() != N * M {
+            return Err(D::Error::invalid_length(v.len(), &"M·N numbers"));
+        }
+        let mut a = [[0.0; N]; M];
+        for (k, x) in v.into_iter().enumerate() {
+            a[k / N][k % N] = x;
+        }
+        Ok(a)
+    }
 }

@@ -2,6 +2,10 @@
 //! ends steps exactly on the edges of the pieces (so no step straddles a kink), and keeps its
 //! step size, method and controllers' memory from one call to the next.
 //!
+//! With `interpolate_ends`, DOPRI5 steps run past the end times and serve them from their
+//! dense output, so that the trajectory and its cost do not depend on how often the caller
+//! asks (communication steps of 10 µs cost what 10 ms cost).
+//!
 //! The method is DOPRI5, or Radau IIA while the problem is stiff ([`Method::Auto`], the rule
 //! in `stiffness`), or either one throughout. Edges are located the same way on both methods'
 //! dense outputs. A non-stiff run pays for the implicit side only Hairer's stiffness
@@ -96,13 +100,41 @@ pub enum Method {
 /// An accepted step, whichever method took it.
 struct Accepted<const N: usize> {
     y1: [f64; N],
-    /// f(t + h, y1) when the method has it (DOPRI5's last stage).
-    k_end: Option<[f64; N]>,
+    /// The DOPRI5 step itself (its last stage is f(t + h, y1); its dense output serves the
+    /// points inside it); None for Radau IIA.
+    explicit: Option<dopri5::Trial<N>>,
     h_next: f64,
     /// The edge the step leaves its piece through, and at which fraction of the step.
     edge: Option<(Edge, f64)>,
     /// DOPRI5's stiffness estimate h·ρ of the step (0 when not asked for).
     h_rho: f64,
+}
+
+/// A DOPRI5 step taken past the end time of a call ([`Solver::interpolate_ends`]): the end
+/// times inside it come from its dense output, and stepping resumes from its end.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+struct Ahead<const N: usize> {
+    t0: f64,
+    step: dopri5::Trial<N>,
+    /// The edge the step ends on, to be crossed when a call goes past it.
+    edge: Option<Edge>,
+    /// What the caller was given last: a call that starts from anything else drops the step.
+    t_out: f64,
+    #[serde(with = "super::serde_array")]
+    y_out: [f64; N],
+}
+
+impl<const N: usize> Ahead<N> {
+    /// (t, y) at t_end inside the step, handed out and remembered.
+    fn serve(&mut self, t: &mut f64, y: &mut [f64; N], t_end: f64) {
+        let theta = (t_end - self.t0) / self.step.h;
+        for (i, yi) in y.iter_mut().enumerate() {
+            *yi = self.step.dense(i, theta);
+        }
+        *t = t_end;
+        self.t_out = t_end;
+        self.y_out = *y;
+    }
 }
 
 /// Where a step starts: t, y and f(t, y).
@@ -119,6 +151,12 @@ pub struct Solver<const N: usize> {
     tol: Tolerance<N>,
     /// Most steps one `advance` may take.
     pub max_steps: u64,
+    /// End times of `advance` are reached by interpolation inside DOPRI5's natural steps
+    /// (4th-order dense output) instead of by steps cut short to end on them: the
+    /// trajectory, and its cost, are then those of a run without those end times, however
+    /// close together they are. For systems that do not change between calls (the bench's
+    /// sine); a caller that changes the system must call `invalidate`.
+    pub interpolate_ends: bool,
     pub stats: Stats,
     method: Method,
     /// Radau IIA is stepping now.
@@ -138,6 +176,7 @@ pub struct Solver<const N: usize> {
     /// An edge was just crossed: the state may lie a rounding error short of it, on the side
     /// of the piece it left, and must not be sent back there.
     just_crossed: bool,
+    ahead: Option<Ahead<N>>,
 }
 
 impl<const N: usize> Solver<N> {
@@ -150,6 +189,7 @@ impl<const N: usize> Solver<N> {
         Solver {
             tol,
             max_steps: 10_000_000,
+            interpolate_ends: false,
             stats: Stats::default(),
             method,
             implicit: method == Method::Implicit,
@@ -162,6 +202,7 @@ impl<const N: usize> Solver<N> {
             k1: [0.0; N],
             k1_valid: false,
             just_crossed: false,
+            ahead: None,
         }
     }
 
@@ -179,6 +220,7 @@ impl<const N: usize> Solver<N> {
     pub fn invalidate(&mut self) {
         self.k1_valid = false;
         self.just_crossed = false;
+        self.ahead = None;
         self.stepper.invalidate();
     }
 
@@ -204,6 +246,22 @@ impl<const N: usize> Solver<N> {
         y: &mut [f64; N],
         t_end: f64,
     ) -> Result<(), SolverError> {
+        if let Some(mut ahead) = self.ahead.take() {
+            if *t != ahead.t_out || *y != ahead.y_out {
+                // Not where the last call left off: k1 was f at the step's end.
+                self.k1_valid = false;
+            } else if t_end <= ahead.t0 + ahead.step.h {
+                ahead.serve(t, y, t_end);
+                self.ahead = Some(ahead);
+                return Ok(());
+            } else {
+                *t = ahead.t0 + ahead.step.h;
+                *y = ahead.step.y1;
+                if let Some(edge) = ahead.edge {
+                    self.cross(sys, edge, *t, y);
+                }
+            }
+        }
         let mut steps = 0u64;
         let mut crossings_here = 0u32;
         while *t < t_end {
@@ -214,8 +272,9 @@ impl<const N: usize> Solver<N> {
             if self.h <= 0.0 {
                 self.h = self.initial_step(sys, *t, y, &k1, t_end - *t);
             }
-            // Reach t_end exactly, without leaving a sliver (Hairer's 1.01).
-            let last = *t + 1.01 * self.h >= t_end;
+            // Reach t_end exactly, without leaving a sliver (Hairer's 1.01), or step past it.
+            let step_past = self.interpolate_ends && !self.implicit;
+            let last = !step_past && *t + 1.01 * self.h >= t_end;
             let h = if last { t_end - *t } else { self.h };
             if h <= 16.0 * f64::EPSILON * t.abs().max(t_end.abs()) {
                 return Err(SolverError::StepTooSmall { t: *t, h });
@@ -240,6 +299,18 @@ impl<const N: usize> Solver<N> {
             if self.implicit {
                 self.stats.implicit_steps += 1;
             }
+            if let Some((edge, theta)) = step.edge
+                && step_past
+                && *t + theta * h > t_end
+            {
+                // The edge lies past t_end: the step redone to end on it is kept ahead, t_end
+                // served from it, and the edge crossed when a call goes past it.
+                let trial = dopri5::step(sys, *t, y, &k1, theta * h);
+                self.stats.rhs_evals += EVALS_PER_STEP;
+                self.h = step.h_next.max(theta * h);
+                self.keep_ahead(trial, Some(edge), t, y, t_end);
+                return Ok(());
+            }
             if let Some((edge, theta)) = step.edge {
                 // Redo the step so that it ends on the edge, then cross it. The state is kept
                 // as the step gives it (not moved onto the edge: where the force is not zero
@@ -258,22 +329,27 @@ impl<const N: usize> Solver<N> {
                         return Err(SolverError::Chattering { t: *t });
                     }
                 }
-                sys.cross(edge, *t, y);
-                self.stats.edges += 1;
-                self.k1_valid = false;
-                self.stepper.invalidate();
-                self.just_crossed = true;
+                self.cross(sys, edge, *t, y);
                 self.h = step.h_next.max(theta * h);
                 continue;
             }
             crossings_here = 0;
             self.just_crossed = false;
-            *t = if last { t_end } else { *t + h };
-            *y = step.y1;
-            match step.k_end {
-                Some(k) => self.k1 = k,
+            match &step.explicit {
+                Some(trial) => self.k1 = *trial.k_end(),
                 None => self.k1_valid = false,
             }
+            if let Some(trial) = step.explicit
+                && step_past
+                && *t + h > t_end
+            {
+                self.h = step.h_next;
+                self.hand_over(step.h_rho);
+                self.keep_ahead(trial, None, t, y, t_end);
+                return Ok(());
+            }
+            *t = if last { t_end } else { *t + h };
+            *y = step.y1;
             // A step cut short to land on t_end says little about the natural step size.
             self.h = if last {
                 step.h_next.max(self.h)
@@ -283,6 +359,37 @@ impl<const N: usize> Solver<N> {
             self.hand_over(step.h_rho);
         }
         Ok(())
+    }
+
+    /// Crosses `edge` at (t, y): the system changes piece, and what was known of the old one
+    /// goes.
+    fn cross<S: Piecewise<N>>(&mut self, sys: &mut S, edge: Edge, t: f64, y: &[f64; N]) {
+        sys.cross(edge, t, y);
+        self.stats.edges += 1;
+        self.k1_valid = false;
+        self.stepper.invalidate();
+        self.just_crossed = true;
+    }
+
+    /// Keeps an accepted DOPRI5 step from (t, y) that reaches past t_end (ending on `edge`,
+    /// if any) and hands out (t_end, y(t_end)) from its dense output.
+    fn keep_ahead(
+        &mut self,
+        step: dopri5::Trial<N>,
+        edge: Option<Edge>,
+        t: &mut f64,
+        y: &mut [f64; N],
+        t_end: f64,
+    ) {
+        let mut ahead = Ahead {
+            t0: *t,
+            step,
+            edge,
+            t_out: t_end,
+            y_out: *y,
+        };
+        ahead.serve(t, y, t_end);
+        self.ahead = Some(ahead);
     }
 
     /// One step of size h from (t, y) with the current method: accepted (with the edge it
@@ -303,7 +410,7 @@ impl<const N: usize> Solver<N> {
             }
             Ok(Accepted {
                 y1: trial.y1,
-                k_end: None,
+                explicit: None,
                 h_next: verdict.h_next,
                 edge: locate_edge(&trial, guard, lo, hi),
                 h_rho: 0.0,
@@ -321,7 +428,6 @@ impl<const N: usize> Solver<N> {
             }
             Ok(Accepted {
                 y1: trial.y1,
-                k_end: Some(*trial.k_end()),
                 h_next: verdict.h_next,
                 edge: locate_edge(&trial, guard, lo, hi),
                 h_rho: if self.method == Method::Auto {
@@ -329,6 +435,7 @@ impl<const N: usize> Solver<N> {
                 } else {
                     0.0
                 },
+                explicit: Some(trial),
             })
         }
     }

@@ -45,3 +45,18 @@ def test_auto_hands_over_on_a_tiny_idler(fmu_run):
     rhs_auto, rhs_explicit = auto["solver_rhs"][-1], explicit["solver_rhs"][-1]
     print(f"I_L 1e-8, 12 ms: auto {rhs_auto:.0f} rhs ({auto['solver_implicit_steps'][-1]:.0f} implicit steps), DOPRI5 alone {rhs_explicit:.0f} rhs")
     assert rhs_auto * 5 < rhs_explicit
+
+
+def test_sine_cost_does_not_depend_on_the_communication_step(fmu_run):
+    """Issue 3: in sine mode communication points are served from the dense output of natural
+    steps, so 10 µs communication steps cost the right-hand sides of 10 ms ones (counted by the
+    FMU), and their values agree with the reference at every point."""
+    t_end = 0.05
+    ref_fine = R.scene("S1", t_end, 1e-5)
+    fine = fmu_run("sine", "S1", t_end, 1e-5)
+    coarse = fmu_run("sine", "S1", t_end, 1e-2)
+    G = R.DEFAULTS["G"]
+    assert np.max(np.abs(fine["xi"] - ref_fine.xi)) <= 1e-4 * G
+    rhs_fine, rhs_coarse = fine["solver_rhs"][-1], coarse["solver_rhs"][-1]
+    print(f"S1 50 ms: {rhs_fine:.0f} rhs at 10 µs, {rhs_coarse:.0f} at 10 ms")
+    assert rhs_fine <= 1.1 * rhs_coarse
