@@ -37,7 +37,7 @@ FMPY = "GearRattle FMU (fmpy)"
 # GearRattle's edge handling (an integrator comparison), and the crates as users write them
 # from MODEL.md (their own literal RHS, region from xi at each call, no edge handling).
 SAME_RHS = ["differential-equations DOPRI5", "differential-equations DOP853", "diffsol Tsit45"]
-USER_RHS = [f"{n}, user's RHS" for n in SAME_RHS]
+USER_RHS = [f"{n} (user's RHS)" for n in SAME_RHS]  # no comma: the CSV is not quoted
 RUST_PEERS = SAME_RHS + USER_RHS
 SCIPY = ["scipy RK45", "scipy DOP853", "scipy Radau", "scipy LSODA"]
 STYLE = {
@@ -323,8 +323,8 @@ def analysis(rows, s1, r_rust, n_rust, r_user, n_user, r_py, n_py, comm_rows, to
             cbrt, trig, pw = share("cbrt"), share("sincos", "__sin", "__cos"), share("pow")
             if perf:
                 a(f"What the profile says: the RHS and the step are now the bulk (the cube root, gear_rattle::math::cbrt, "
-                  "and the excitation's sine and cosine, math::sin_cos, are inlined into the RHS; the controller takes "
-                  f"one `powf` per step). Library calls left: sin/cos {trig:.0f} % (the band's sine, glibc's), pow "
+                  "and the excitation's sine and cosine, math::sin_cos, are inlined into the RHS; the step-size "
+                  f"controller still calls `powf` twice per step). Library calls left: sin/cos {trig:.0f} % (the band's sine, glibc's), pow "
                   f"{pw:.0f} %" + (f", cbrt {cbrt:.0f} %" if cbrt >= 1 else "") + ". Closed-form free flight would "
                   f"remove only the gap's {gap['cpu']:.0f} % (free flight is short here: {gap['pct']:.0f} % of the "
                   f"RHS), the edges cost {p['edge_pct']:.0f} % of the RHS, rejected steps {p['reject_pct']:.0f} %.")
