@@ -41,6 +41,18 @@ const COMM_STEPS: [f64; 4] = [1e-2, 1e-3, 1e-4, 1e-5];
 const GRID: f64 = 1e-3;
 /// Error level at which solvers are compared (issue 3: 1e-9 m = 4e-5 G on S1).
 const TARGET_ERROR: f64 = 1e-9;
+/// The peers with GearRattle's RHS and event handling (an integrator comparison)...
+const PEERS_SAME_RHS: [&str; 3] = [
+    "differential-equations DOPRI5",
+    "differential-equations DOP853",
+    "diffsol Tsit45",
+];
+/// ...and as a user writes them: the RHS literally from MODEL.md, no event handling.
+const PEERS_USER_RHS: [&str; 3] = [
+    "differential-equations DOPRI5 (user's RHS)",
+    "differential-equations DOP853 (user's RHS)",
+    "diffsol Tsit45 (user's RHS)",
+];
 
 // ---------------------------------------------------------------------------------------
 // CPU time of this thread (the FMU runs in it too)
@@ -234,13 +246,19 @@ fn run_peer<S: Stepper>(
     Ok((Sampled { run, stride: 1 }, cpu))
 }
 
-fn model(sc: &Scene) -> Model {
+/// The model a peer integrates: GearRattle's RHS with its event handling (`user` false), or
+/// the RHS as a user writes it from MODEL.md without event handling (`user` true).
+fn model(sc: &Scene, user: bool) -> Model {
     let p = sc.params();
-    Model::new(
+    let mut m = Model::new(
         Dynamics::new(p),
         excitation(sc),
         gear_rattle::physics::ContactLaw::new(&p).classify(0.5 * p.G),
-    )
+    );
+    if user {
+        m.user = Some(peers::UserRhs::new(p, sc.A_rms, sc.f_exc));
+    }
+    m
 }
 
 /// The tolerances a crate is given: the same weights as GearRattle's (ξ on the scale of G, ξ'
@@ -260,61 +278,37 @@ fn rtols(rtol: f64) -> [f64; N] {
     [rtol, rtol, 0.0, 0.0, 0.0]
 }
 
-fn run_dopri5(sc: &Scene, rtol: f64) -> Outcome {
-    let start = cpu_now();
-    let model = model(sc);
-    let method = ExplicitRungeKutta::dopri5()
-        .rtol(rtols(rtol))
-        .atol(atol(sc, rtol))
-        .max_steps(usize::MAX);
-    run_peer(
-        sc,
-        rtol,
-        &model,
-        &mut peers::de::De::new(method, sc.t_end),
-        start,
-    )
+/// The explicit Runge-Kutta pairs of differential-equations: DOPRI5 or DOP853.
+#[derive(Clone, Copy)]
+enum DeMethod {
+    Dopri5,
+    Dop853,
 }
 
-/// DOPRI5 of differential-equations on the RHS written straight from MODEL.md, without
-/// event handling: what a user of the crate gets without locating the band edges.
-fn run_dopri5_plain(sc: &Scene, rtol: f64) -> Outcome {
+fn run_de(sc: &Scene, rtol: f64, which: DeMethod, user: bool) -> Outcome {
     let start = cpu_now();
-    let mut model = model(sc);
-    model.plain = true;
-    let method = ExplicitRungeKutta::dopri5()
-        .rtol(rtols(rtol))
-        .atol(atol(sc, rtol))
-        .max_steps(usize::MAX);
-    run_peer(
-        sc,
-        rtol,
-        &model,
-        &mut peers::de::De::new(method, sc.t_end),
-        start,
-    )
+    let model = model(sc, user);
+    // The two pairs are different types: one builder expression, instantiated for each.
+    macro_rules! run {
+        ($pair:ident) => {{
+            let method = ExplicitRungeKutta::$pair()
+                .rtol(rtols(rtol))
+                .atol(atol(sc, rtol))
+                .max_steps(usize::MAX);
+            let mut stepper = peers::de::De::new(method, sc.t_end);
+            run_peer(sc, rtol, &model, &mut stepper, start)
+        }};
+    }
+    match which {
+        DeMethod::Dopri5 => run!(dopri5),
+        DeMethod::Dop853 => run!(dop853),
+    }
 }
 
-fn run_dop853(sc: &Scene, rtol: f64) -> Outcome {
-    let start = cpu_now();
-    let model = model(sc);
-    let method = ExplicitRungeKutta::dop853()
-        .rtol(rtols(rtol))
-        .atol(atol(sc, rtol))
-        .max_steps(usize::MAX);
-    run_peer(
-        sc,
-        rtol,
-        &model,
-        &mut peers::de::De::new(method, sc.t_end),
-        start,
-    )
-}
-
-fn run_tsit45(sc: &Scene, rtol: f64) -> Outcome {
+fn run_tsit45(sc: &Scene, rtol: f64, user: bool) -> Outcome {
     use diffsol::{NalgebraMat, OdeBuilder};
     let start = cpu_now();
-    let model = model(sc);
+    let model = model(sc, user);
     let p = sc.params();
     let y_start = y0(&p);
     let problem = OdeBuilder::<NalgebraMat<f64>>::new()
@@ -642,9 +636,9 @@ fn main() {
         let r = load_reference(&ref_dir, &sc.base);
         let rtol: f64 = std::env::var("BENCH_DEBUG_RTOL").unwrap().parse().unwrap();
         let out = match which.as_str() {
-            "dop853" => run_dop853(sc, rtol),
-            "dopri5" => run_dopri5(sc, rtol),
-            "tsit45" => run_tsit45(sc, rtol),
+            "dop853" => run_de(sc, rtol, DeMethod::Dop853, false),
+            "dopri5" => run_de(sc, rtol, DeMethod::Dopri5, false),
+            "tsit45" => run_tsit45(sc, rtol, false),
             _ => run_gearrattle(sc, rtol),
         }
         .unwrap();
@@ -706,39 +700,35 @@ fn main() {
     for sc in &scenes {
         let reference = load_reference(&ref_dir, &sc.base);
         for &rtol in &tols {
-            // The integrators, side by side.
-            let configs = vec![
-                Config {
-                    solver: "GearRattle (direct)",
+            // The integrators, side by side: GearRattle, then each crate with GearRattle's RHS
+            // and event handling, then each crate as a user writes it from MODEL.md.
+            let mut configs = vec![Config {
+                solver: "GearRattle (direct)",
+                comm: None,
+                rtol,
+                runner: Box::new(|| run_gearrattle(sc, rtol)),
+            }];
+            for (user, names) in [(false, PEERS_SAME_RHS), (true, PEERS_USER_RHS)] {
+                let [dopri5, dop853, tsit45] = names;
+                configs.push(Config {
+                    solver: dopri5,
                     comm: None,
                     rtol,
-                    runner: Box::new(|| run_gearrattle(sc, rtol)),
-                },
-                Config {
-                    solver: "differential-equations DOPRI5",
+                    runner: Box::new(move || run_de(sc, rtol, DeMethod::Dopri5, user)),
+                });
+                configs.push(Config {
+                    solver: dop853,
                     comm: None,
                     rtol,
-                    runner: Box::new(|| run_dopri5(sc, rtol)),
-                },
-                Config {
-                    solver: "differential-equations DOP853",
+                    runner: Box::new(move || run_de(sc, rtol, DeMethod::Dop853, user)),
+                });
+                configs.push(Config {
+                    solver: tsit45,
                     comm: None,
                     rtol,
-                    runner: Box::new(|| run_dop853(sc, rtol)),
-                },
-                Config {
-                    solver: "diffsol Tsit45",
-                    comm: None,
-                    rtol,
-                    runner: Box::new(|| run_tsit45(sc, rtol)),
-                },
-                Config {
-                    solver: "differential-equations DOPRI5 without edge handling",
-                    comm: None,
-                    rtol,
-                    runner: Box::new(|| run_dopri5_plain(sc, rtol)),
-                },
-            ];
+                    runner: Box::new(move || run_tsit45(sc, rtol, user)),
+                });
+            }
             let measured = measure(configs, budget, max_reps);
             report(sc, &reference, &measured, &mut lines);
             // The FMU through its C API and the same simulation without FMI, per
@@ -823,35 +813,37 @@ fn summary(scenes: &[Scene], ref_dir: &Path, s1: &[Measured]) {
             .collect()
     };
     println!("\nS1 (1 s): CPU time at max |dxi| = {TARGET_ERROR:e} m (log-log interpolation):");
-    let names = [
-        "GearRattle (direct)",
-        "differential-equations DOPRI5",
-        "differential-equations DOP853",
-        "diffsol Tsit45",
-    ];
-    let costs: Vec<Option<(f64, bool)>> = names
-        .iter()
-        .map(|n| cost_at(&curve(n, None), TARGET_ERROR))
-        .collect();
-    for (n, c) in names.iter().zip(&costs) {
-        match c {
-            Some((c, exact)) => println!(
-                "  {n:32} {c:.3e} s{}",
-                if *exact { "" } else { " (upper bound)" }
-            ),
-            None => println!("  {n:32} does not reach it"),
-        }
-    }
-    if let Some((gr, _)) = costs[0] {
-        let best = costs[1..]
+    let gr = cost_at(&curve("GearRattle (direct)", None), TARGET_ERROR);
+    let show = |n: &str, c: Option<(f64, bool)>| match c {
+        Some((c, exact)) => println!(
+            "  {n:44} {c:.3e} s{}",
+            if exact { "" } else { " (upper bound)" }
+        ),
+        None => println!("  {n:44} does not reach it"),
+    };
+    show("GearRattle (direct)", gr);
+    for (kind, names) in [
+        ("GearRattle's RHS and edge handling", PEERS_SAME_RHS),
+        ("user's RHS from MODEL.md, no edge handling", PEERS_USER_RHS),
+    ] {
+        let costs: Vec<Option<(f64, bool)>> = names
             .iter()
-            .flatten()
-            .map(|c| c.0)
-            .fold(f64::INFINITY, f64::min);
-        println!(
-            "  fastest Rust crate / GearRattle: {:.2}x (target >= 3)",
-            best / gr
-        );
+            .map(|n| cost_at(&curve(n, None), TARGET_ERROR))
+            .collect();
+        for (n, c) in names.iter().zip(&costs) {
+            show(n, *c);
+        }
+        if let Some((gr, _)) = gr {
+            let best = costs
+                .iter()
+                .flatten()
+                .map(|c| c.0)
+                .fold(f64::INFINITY, f64::min);
+            println!(
+                "  fastest Rust crate ({kind}) / GearRattle: {:.2}x (target >= 3)",
+                best / gr
+            );
+        }
     }
     for &rtol in &[1e-6, 1e-8] {
         let at = |solver: &str, comm: f64| {

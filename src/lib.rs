@@ -2,6 +2,7 @@
 //! 2009) as an FMI 2.0 Co-Simulation FMU.
 //!
 //! Layers, each knowing nothing of the ones above it:
+//! - [`math`]: cheap elementary functions for the right-hand side (cube root, sine);
 //! - [`physics`]: contact law, equation of motion, excitation (MODEL.md);
 //! - [`integrator`]: adaptive DOPRI5 with error control, dense output and edge location;
 //! - [`rattle`]: the gear pair as a piecewise ODE for the integrator, with impact counting;
@@ -14,6 +15,7 @@ pub mod contract;
 pub mod ffi;
 pub mod instance;
 pub mod integrator;
+pub mod math;
 pub mod packaging;
 pub mod physics;
 pub mod rattle;

@@ -22,14 +22,76 @@
 //! (differential-equations' `Event`, diffsol's root functions) watch sign changes at step ends
 //! only and would skip a grazing contact; they are not used.
 //!
-//! `Model::plain` is the exception, for comparison: no event handling at all, the region
-//! found from ξ at each evaluation, steps straddling the kinks of the contact law.
+//! The second kind of peer is the crate as a user would use it after reading MODEL.md: the
+//! right-hand side written literally from it ([`UserRhs`]: powf for |δ/G|^(α−1), the band's
+//! sine as written in §2, the excitation's sin and cos, the region found from ξ at each call),
+//! one function shared by every crate, and no event handling: the crate's own stepping only,
+//! steps straddling the kinks of the contact law. Outputs still end steps on the 1 ms grid
+//! points (as each crate does at its final time), so that the error is the method's, not an
+//! interpolant's.
 
 use std::cell::Cell;
 
 use gear_rattle::integrator::{Edge, Piecewise, System};
-use gear_rattle::physics::{Dynamics, Excitation, Region};
+use gear_rattle::physics::{Dynamics, Excitation, GearParams, Region};
 use gear_rattle::rattle::{Impacts, N, Rattle, State, XI, XI_DOT};
+
+/// MODEL.md §2, §3 and §5 written out literally: the right-hand side a user of a general ODE
+/// crate writes for the state [ξ, ξ', E_contact, E_lubricant, W_shaft], with the region taken
+/// from ξ at each call (nothing of GearRattle's code: its own powf, sin, sin and cos).
+#[derive(Clone, Copy, Debug)]
+pub struct UserRhs {
+    pub p: GearParams,
+    /// A = √2 A_rms and w = 2πf of the bench sine.
+    amplitude: f64,
+    w: f64,
+}
+
+impl UserRhs {
+    pub fn new(p: GearParams, a_rms: f64, f_exc: f64) -> Self {
+        UserRhs {
+            p,
+            amplitude: 2f64.sqrt() * a_rms,
+            w: 2.0 * std::f64::consts::PI * f_exc,
+        }
+    }
+
+    #[inline]
+    pub fn rhs(&self, t: f64, y: &State) -> State {
+        use std::f64::consts::PI;
+        let p = &self.p;
+        let (xi, v) = (y[XI], y[XI_DOT]);
+        let a_m = self.amplitude * (self.w * t).sin();
+        let om_m = -self.amplitude / self.w * (self.w * t).cos();
+        let (eps, g) = (p.epsilon, p.G);
+        let (s, delta) = if xi <= -eps {
+            (1.0, xi)
+        } else if xi <= 0.0 {
+            (0.5 * (1.0 - (PI / eps * (eps / 2.0 + xi)).sin()), xi)
+        } else if xi <= g {
+            (0.0, 0.0)
+        } else if xi <= g + eps {
+            (
+                0.5 * (1.0 - (PI / eps * (eps / 2.0 - (xi - g))).sin()),
+                xi - g,
+            )
+        } else {
+            (1.0, xi - g)
+        };
+        let f_k = s * p.K_star * delta * (delta / g).abs().powf(p.alpha - 1.0);
+        let f_c = s * p.C_LM * v;
+        let f = f_k + f_c;
+        let om_l = (v + p.r_M * om_m) / p.r_L;
+        let dom_l = (p.B - p.r_L * f - p.C * (om_l - p.omega_S)) / p.I_L;
+        [
+            v,
+            p.r_L * dom_l - p.r_M * a_m,
+            f_c * v,
+            p.C * (om_l - p.omega_S) * (om_l - p.omega_S),
+            -p.r_M * f * om_m,
+        ]
+    }
+}
 
 /// The gear pair's right-hand side with the region read from a cell, so that a crate's
 /// closure or trait object can follow region changes made by the driver. Counts evaluations.
@@ -38,9 +100,9 @@ pub struct Model {
     pub excitation: Excitation,
     pub region: Cell<Region>,
     pub evals: Cell<u64>,
-    /// No event handling: the region is found from ξ at each evaluation (the RHS a user
-    /// writes straight from MODEL.md), so steps straddle the kinks of the contact law.
-    pub plain: bool,
+    /// The peer as a user writes it: this RHS instead of `Rattle`'s, and no event handling
+    /// (steps straddle the kinks of the contact law).
+    pub user: Option<UserRhs>,
 }
 
 impl Model {
@@ -50,22 +112,20 @@ impl Model {
             excitation,
             region: Cell::new(region),
             evals: Cell::new(0),
-            plain: false,
+            user: None,
         }
     }
 
-    /// f(t, y) with the current region's formula: exactly `Rattle::rhs`.
+    /// f(t, y): `Rattle::rhs` with the current region's formula, or the user's RHS.
     #[inline]
     pub fn rhs(&self, t: f64, y: &State) -> State {
         self.evals.set(self.evals.get() + 1);
-        let region = if self.plain {
-            self.dynamics.law.classify(y[XI])
-        } else {
-            self.region.get()
-        };
+        if let Some(user) = &self.user {
+            return user.rhs(t, y);
+        }
         let rattle = Rattle {
             dynamics: self.dynamics,
-            region,
+            region: self.region.get(),
             excitation: self.excitation,
             impacts: Impacts::default(),
         };
@@ -253,7 +313,7 @@ pub fn drive<S: Stepper>(
         s.step(model, stop)?;
         run.steps += 1;
         let (lo, hi) = rattle.piece();
-        if model.plain {
+        if model.user.is_some() {
             // No edge handling: follow ξ's region after the step to count impacts.
             (t, y) = (s.t(), s.y());
             rattle.settle(t, &y);

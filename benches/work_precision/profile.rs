@@ -120,20 +120,15 @@ pub fn run(scenes: &[Scene]) {
     let rhs_time: f64 = (0..5).map(|i| evals[i] as f64 * ns[i] * 1e-9).sum();
     // The same right-hand side written literally from MODEL.md, as a peer's user would write
     // it (powf for |δ/G|^(α−1), the band's sine as written, sin and cos of the excitation).
+    let user = peers::UserRhs::new(p, sc.A_rms, sc.f_exc);
     let mut ns_literal = [0.0; 5];
-    for (i, (region, _)) in REGIONS.iter().enumerate() {
+    for i in 0..REGIONS.len() {
         let n = 300_000;
         let mut acc = 0.0;
         let t0 = cpu_now();
         for k in 0..n {
             let yy = [states[i], 0.05, 0.0, 0.0, 0.0];
-            let f = literal_rhs(
-                std::hint::black_box(&p),
-                sc,
-                *region,
-                k as f64 * 1e-7,
-                std::hint::black_box(&yy),
-            );
+            let f = std::hint::black_box(&user).rhs(k as f64 * 1e-7, std::hint::black_box(&yy));
             acc += f[1];
         }
         ns_literal[i] = (cpu_now() - t0) / n as f64 * 1e9;
@@ -187,38 +182,4 @@ pub fn run(scenes: &[Scene]) {
         100.0 * (1.0 - rhs_time / per_run),
         (per_run - rhs_time) / run.rhs as f64 * 1e9
     );
-}
-
-/// MODEL.md §2-3 written out literally for one region: the right-hand side a user of a
-/// general ODE crate would write (state [ξ, ξ', E_contact, E_lubricant, W_shaft]).
-fn literal_rhs(p: &GearParams, sc: &Scene, region: Region, t: f64, y: &State) -> State {
-    use std::f64::consts::PI;
-    let (xi, v) = (y[XI], y[XI_DOT]);
-    let w = 2.0 * PI * sc.f_exc;
-    let amp = 2f64.sqrt() * sc.A_rms;
-    let a_m = amp * (w * t).sin();
-    let om_m = -amp / w * (w * t).cos();
-    let (eps, g) = (p.epsilon, p.G);
-    let (s, delta) = match region {
-        Region::ContactPlus => (1.0, xi),
-        Region::BandPlus => (0.5 * (1.0 - (PI / eps * (eps / 2.0 + xi)).sin()), xi),
-        Region::Gap => (0.0, 0.0),
-        Region::BandMinus => (
-            0.5 * (1.0 - (PI / eps * (eps / 2.0 - (xi - g))).sin()),
-            xi - g,
-        ),
-        Region::ContactMinus => (1.0, xi - g),
-    };
-    let f_k = s * p.K_star * delta * (delta / g).abs().powf(p.alpha - 1.0);
-    let f_c = s * p.C_LM * v;
-    let f = f_k + f_c;
-    let om_l = (v + p.r_M * om_m) / p.r_L;
-    let dom_l = (p.B - p.r_L * f - p.C * (om_l - p.omega_S)) / p.I_L;
-    [
-        v,
-        p.r_L * dom_l - p.r_M * a_m,
-        f_c * v,
-        p.C * (om_l - p.omega_S) * (om_l - p.omega_S),
-        -p.r_M * f * om_m,
-    ]
 }

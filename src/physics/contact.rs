@@ -171,28 +171,27 @@ impl ContactLaw {
         }
     }
 
-    /// δ |δ/G|^(α−1), the elastic law without K* and s.
+    /// |δ/G|^(α−1): the factor that the elastic law (δ times it) and its slope (α times it)
+    /// share, computed once for both.
     #[inline]
-    fn spring(&self, delta: f64) -> f64 {
-        let ratio = delta.abs() * self.inv_G;
-        delta
-            * match self.power {
-                Power::One => 1.0,
-                Power::FourThirds => ratio.cbrt(),
-                Power::ThreeHalves => ratio.sqrt(),
-                Power::General(exponent) => ratio.powf(exponent),
-            }
-    }
-
-    /// d/dδ of δ |δ/G|^(α−1), which is α |δ/G|^(α−1).
-    #[inline]
-    fn spring_slope(&self, delta: f64) -> f64 {
+    fn stiffening(&self, delta: f64) -> f64 {
         let ratio = delta.abs() * self.inv_G;
         match self.power {
             Power::One => 1.0,
-            Power::FourThirds => 4.0 / 3.0 * ratio.cbrt(),
-            Power::ThreeHalves => 1.5 * ratio.sqrt(),
-            Power::General(exponent) => (1.0 + exponent) * ratio.powf(exponent),
+            Power::FourThirds => crate::math::cbrt(ratio),
+            Power::ThreeHalves => ratio.sqrt(),
+            Power::General(exponent) => ratio.powf(exponent),
+        }
+    }
+
+    /// α, the ratio of the elastic law's slope α|δ/G|^(α−1) to the stiffening |δ/G|^(α−1).
+    #[inline]
+    fn alpha(&self) -> f64 {
+        match self.power {
+            Power::One => 1.0,
+            Power::FourThirds => 4.0 / 3.0,
+            Power::ThreeHalves => 1.5,
+            Power::General(exponent) => 1.0 + exponent,
         }
     }
 
@@ -218,7 +217,7 @@ impl ContactLaw {
             }
         };
         ContactForce {
-            elastic: s * self.K_star * self.spring(delta),
+            elastic: s * self.K_star * (delta * self.stiffening(delta)),
             dissipative: s * self.C_LM * xi_dot,
         }
     }
@@ -254,9 +253,10 @@ impl ContactLaw {
                 (self.smoothing(delta), ds, delta)
             }
         };
-        let unsmoothed = self.K_star * self.spring(delta) + self.C_LM * xi_dot;
+        let stiffening = self.stiffening(delta);
+        let unsmoothed = self.K_star * (delta * stiffening) + self.C_LM * xi_dot;
         ForceSlopes {
-            d_xi: ds * unsmoothed + s * self.K_star * self.spring_slope(delta),
+            d_xi: ds * unsmoothed + s * self.K_star * (self.alpha() * stiffening),
             d_xi_dot: s * self.C_LM,
         }
     }

@@ -33,7 +33,7 @@ impl Sine {
     /// Exact θ_M = ω̄ t − A/w² sin(wt), ω_M = ω̄ − A/w cos(wt), a_M = A sin(wt).
     #[inline]
     pub fn at(&self, t: f64) -> Shaft {
-        let (sin, cos) = (self.w * t).sin_cos();
+        let (sin, cos) = crate::math::sin_cos(self.w * t);
         let a_over_w = self.amplitude / self.w;
         Shaft {
             theta: self.omega_mean * t - a_over_w / self.w * sin,
