@@ -10,7 +10,7 @@ pub mod torque;
 use serde::{Deserialize, Serialize};
 
 use crate::integrator::{Edge, Piecewise, System, Tolerance};
-use crate::physics::{Dynamics, Excitation, GearParams, Region};
+use crate::physics::{Dynamics, Excitation, GearParams, Region, Shaft};
 
 /// Components of the state vector.
 pub const XI: usize = 0;
@@ -65,6 +65,36 @@ impl Rattle {
             atol: [rtol * xi_scale, rtol * xi_dot_scale, 0.0, 0.0, 0.0],
             controlled: 2,
         }
+    }
+}
+
+/// What the co-simulation reads from the gear pair whatever drives its main shaft: ξ and ξ'
+/// are the components `GUARD` and `RATE`; the dissipated energies sit at `E_CONTACT` and
+/// `E_LUBRICANT`.
+pub trait GearPair<const N: usize>: Piecewise<N> {
+    const E_CONTACT: usize;
+    const E_LUBRICANT: usize;
+    fn dynamics(&self) -> &Dynamics;
+    fn region(&self) -> Region;
+    fn impacts(&self) -> &Impacts;
+    /// θ_M, ω_M and a_M of the main shaft at (t, y).
+    fn shaft(&self, t: f64, y: &[f64; N]) -> Shaft;
+}
+
+impl GearPair<N> for Rattle {
+    const E_CONTACT: usize = E_CONTACT;
+    const E_LUBRICANT: usize = E_LUBRICANT;
+    fn dynamics(&self) -> &Dynamics {
+        &self.dynamics
+    }
+    fn region(&self) -> Region {
+        self.region
+    }
+    fn impacts(&self) -> &Impacts {
+        &self.impacts
+    }
+    fn shaft(&self, t: f64, _y: &State) -> Shaft {
+        self.excitation.at(t)
     }
 }
 

@@ -15,20 +15,17 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::{Impacts, cross_edge, scales};
+use super::{GearPair, Impacts, cross_edge, scales};
+pub use super::{XI, XI_DOT};
 use crate::integrator::{Edge, Jacobian, Piecewise, System, Tolerance};
 use crate::physics::{Dynamics, Loads, MainShaft, Region, Shaft, TorqueRamp};
 
-/// Components of the state vector.
-pub const XI: usize = 0;
-pub const XI_DOT: usize = 1;
+/// Components of the state vector after ξ, ξ' (the quadratures' meanings as in
+/// [`crate::rattle`]).
 pub const THETA_M: usize = 2;
 pub const OMEGA_M: usize = 3;
-/// ∫ F_c ξ' dt [J].
 pub const E_CONTACT: usize = 4;
-/// ∫ C (ω_L − ω_S)² dt [J].
 pub const E_LUBRICANT: usize = 5;
-/// ∫ −τ_M ω_M dt: work the main shaft feeds into the loose gear [J].
 pub const W_SHAFT: usize = 6;
 pub const N: usize = 7;
 
@@ -88,6 +85,23 @@ impl TorqueRattle {
             y[OMEGA_M],
             self.torque.at(t),
         )
+    }
+}
+
+impl GearPair<N> for TorqueRattle {
+    const E_CONTACT: usize = E_CONTACT;
+    const E_LUBRICANT: usize = E_LUBRICANT;
+    fn dynamics(&self) -> &Dynamics {
+        &self.dynamics
+    }
+    fn region(&self) -> Region {
+        self.region
+    }
+    fn impacts(&self) -> &Impacts {
+        &self.impacts
+    }
+    fn shaft(&self, t: f64, y: &State) -> Shaft {
+        self.loads(t, y).1
     }
 }
 
