@@ -1,5 +1,6 @@
 //! Energy balance of MODEL.md §3 with C = C_LM = 0 (and B = 0): ½ I_L ω_L² + V(ξ) minus the
-//! work fed in by the main shaft stays constant. V is integrated here from MODEL.md's
+//! work fed in by the main shaft stays constant (in torque mode, with the shaft's kinetic
+//! energy, minus the work of the drivetrain's torque). V is integrated here from MODEL.md's
 //! contact law (tests/common), independently of the crate.
 #![allow(non_snake_case)]
 
@@ -10,8 +11,8 @@ use gear_rattle::integrator::Solver;
 use gear_rattle::physics::{Dynamics, Excitation, GearParams, Sine};
 use gear_rattle::rattle::{self, Rattle, W_SHAFT, XI, XI_DOT};
 
-#[test]
-fn energy_is_conserved_without_dissipation_over_one_second_of_s1() {
+/// The paper's gear pair without its dampings, for the crate and for MODEL.md written out.
+fn lossless() -> (GearParams, Paper) {
     let params = GearParams {
         C_LM: 0.0,
         C: 0.0,
@@ -24,6 +25,12 @@ fn energy_is_conserved_without_dissipation_over_one_second_of_s1() {
         G: params.G,
         C_LM: 0.0,
     };
+    (params, paper)
+}
+
+#[test]
+fn energy_is_conserved_without_dissipation_over_one_second_of_s1() {
+    let (params, paper) = lossless();
     let excitation = Excitation::Sine(Sine::new(300.0, 30.0, 0.0));
     let mut rattle = Rattle::new(Dynamics::new(params), excitation, 0.5 * params.G);
     let mut solver = Solver::new(rattle.tolerance(1e-12));
@@ -67,18 +74,7 @@ fn energy_is_conserved_in_torque_mode_without_dissipation() {
     use gear_rattle::physics::{MainShaft, TorqueRamp};
     use gear_rattle::rattle::torque::{self, OMEGA_M, THETA_M, TorqueRattle};
 
-    let params = GearParams {
-        C_LM: 0.0,
-        C: 0.0,
-        ..GearParams::paper()
-    };
-    let paper = Paper {
-        K_star: params.K_star,
-        alpha: params.alpha,
-        epsilon: params.epsilon,
-        G: params.G,
-        C_LM: 0.0,
-    };
+    let (params, paper) = lossless();
     let I_M = 0.008;
     let (amplitude, w) = (I_M * 2f64.sqrt() * 300.0, 2.0 * std::f64::consts::PI * 30.0);
     let torque_at = |t: f64| amplitude * (w * t).sin();
