@@ -50,7 +50,7 @@ impl<S: GearPair<N>, const N: usize> Stepped<S, N> {
         self.solver.advance(&mut self.system, t, &mut self.y, t_end)
     }
 
-    fn now(&self, t: f64) -> Now<'_> {
+    fn now(&self) -> Now<'_> {
         let (sys, y) = (&self.system, &self.y);
         Now {
             dynamics: sys.dynamics(),
@@ -60,7 +60,6 @@ impl<S: GearPair<N>, const N: usize> Stepped<S, N> {
             xi_dot: y[S::RATE],
             e_contact: y[S::E_CONTACT],
             e_lubricant: y[S::E_LUBRICANT],
-            shaft: sys.shaft(t, y),
             stats: self.solver.stats,
         }
     }
@@ -83,7 +82,8 @@ pub struct Simulation {
     pub drive: Drive,
 }
 
-/// What every output is computed from at the current time, whichever the coupling.
+/// What every output is computed from at the current time, whichever the coupling (the
+/// shaft's motion apart: [`Simulation::shaft`], computed only for the outputs that need it).
 struct Now<'a> {
     dynamics: &'a Dynamics,
     region: Region,
@@ -92,15 +92,13 @@ struct Now<'a> {
     xi_dot: f64,
     e_contact: f64,
     e_lubricant: f64,
-    /// θ_M, ω_M, α_M now (in torque mode α_M follows from τ_in and the contact).
-    shaft: Shaft,
     stats: Stats,
 }
 
 impl Now<'_> {
-    fn loads(&self) -> crate::physics::Loads {
+    fn loads(&self, shaft: &Shaft) -> crate::physics::Loads {
         self.dynamics
-            .loads(self.region, self.xi, self.xi_dot, &self.shaft)
+            .loads(self.region, self.xi, self.xi_dot, shaft)
     }
 }
 
@@ -226,14 +224,17 @@ impl Simulation {
     /// The state the outputs are computed from, now.
     fn now(&self) -> Now<'_> {
         match &self.gear {
-            Gear::Kinematic(k) => k.now(self.t),
-            Gear::Torque(k) => k.now(self.t),
+            Gear::Kinematic(k) => k.now(),
+            Gear::Torque(k) => k.now(),
         }
     }
 
-    /// The main shaft's motion now.
+    /// The main shaft's motion now (in torque mode α_M follows from τ_in and the contact).
     pub fn shaft(&self) -> Shaft {
-        self.now().shaft
+        match &self.gear {
+            Gear::Kinematic(k) => k.system.shaft(self.t, &k.y),
+            Gear::Torque(k) => k.system.shaft(self.t, &k.y),
+        }
     }
 
     /// Impacts counted so far.
@@ -287,19 +288,22 @@ impl Simulation {
 
     /// Advances to t_end. On failure the simulation is left as it was.
     pub fn step_to(&mut self, t_end: f64) -> Result<(), SolverError> {
-        let mut next = *self;
-        match &mut next.gear {
-            Gear::Kinematic(k) => k.advance(&mut next.t, t_end)?,
-            Gear::Torque(k) => k.advance(&mut next.t, t_end)?,
+        let before = *self;
+        let advanced = match &mut self.gear {
+            Gear::Kinematic(k) => k.advance(&mut self.t, t_end),
+            Gear::Torque(k) => k.advance(&mut self.t, t_end),
+        };
+        if let Err(e) = advanced {
+            *self = before;
+            return Err(e);
         }
-        next.t = t_end;
+        self.t = t_end;
         // The inputs continue along their extrapolation unless the master sets new ones.
-        match (&mut next.drive, &next.gear) {
+        match (&mut self.drive, &self.gear) {
             (Drive::Inputs(shaft), Gear::Kinematic(k)) => *shaft = k.system.excitation.at(t_end),
             (Drive::Torque { tau, .. }, Gear::Torque(k)) => *tau = k.system.torque.at(t_end),
             _ => {}
         }
-        *self = next;
         Ok(())
     }
 
@@ -307,22 +311,23 @@ impl Simulation {
     pub fn real_output(&self, vr: u32) -> Option<f64> {
         let now = self.now();
         let dynamics = now.dynamics;
-        let shaft = now.shaft;
+        let shaft = || self.shaft();
+        let loads = || now.loads(&shaft());
         Some(match vr {
-            vr::theta_L => dynamics.theta_L(now.xi, &shaft),
-            vr::omega_L => now.loads().omega_L,
-            vr::alpha_L => now.loads().alpha_L,
-            vr::a_pitch_L => dynamics.params.r_L * now.loads().alpha_L,
+            vr::theta_L => dynamics.theta_L(now.xi, &shaft()),
+            vr::omega_L => loads().omega_L,
+            vr::alpha_L => loads().alpha_L,
+            vr::a_pitch_L => dynamics.params.r_L * loads().alpha_L,
             vr::xi => now.xi,
             vr::xi_dot => now.xi_dot,
-            vr::F_contact => now.loads().force.total(),
-            vr::tau_M => dynamics.tau_M(&now.loads()),
+            vr::F_contact => loads().force.total(),
+            vr::tau_M => dynamics.tau_M(&loads()),
             vr::impact_speed => now.impacts.last_speed,
             vr::E_contact => now.e_contact,
             vr::E_lubricant => now.e_lubricant,
-            vr::theta_M_out => shaft.theta,
-            vr::omega_M_out => shaft.omega,
-            vr::alpha_M_out => shaft.alpha,
+            vr::theta_M_out => shaft().theta,
+            vr::omega_M_out => shaft().omega,
+            vr::alpha_M_out => shaft().alpha,
             vr::solver_steps => now.stats.accepted as f64,
             vr::solver_rejected => now.stats.rejected as f64,
             vr::solver_rhs => now.stats.rhs_evals as f64,
@@ -336,9 +341,9 @@ impl Simulation {
         let now = self.now();
         let dynamics = now.dynamics;
         let p = &dynamics.params;
-        let shaft = now.shaft;
+        let shaft = self.shaft();
         let (xi, xi_dot) = (now.xi, now.xi_dot);
-        let loads = now.loads();
+        let loads = now.loads(&shaft);
         let force_rate = || {
             let slopes = dynamics.law.slopes(now.region, xi, xi_dot);
             slopes.d_xi * xi_dot + slopes.d_xi_dot * loads.xi_ddot
