@@ -379,9 +379,10 @@ fn run_steps(sc: &Scene, rtol: f64, comm: f64) -> Outcome {
     }
     let cpu = cpu_now() - start;
     std::hint::black_box(sink);
-    run.rhs = sim.solver.stats.rhs_evals;
-    run.steps = sim.solver.stats.accepted + sim.solver.stats.rejected;
-    run.edges = sim.solver.stats.edges;
+    let stats = sim.stats();
+    run.rhs = stats.rhs_evals;
+    run.steps = stats.accepted + stats.rejected;
+    run.edges = stats.edges;
     Ok((Sampled { run, stride }, cpu))
 }
 

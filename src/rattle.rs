@@ -1,13 +1,16 @@
 //! The rattling gear as a piecewise-smooth ODE for the integrator: the state layout, the
 //! right-hand side (MODEL.md §3 plus the dissipated energies and the shaft's work as
 //! quadratures), the region as the current piece, and the impact counters (MODEL.md §1: an
-//! impact is ξ leaving the gap, across 0 downwards on F+ or G upwards on F−).
+//! impact is ξ leaving the gap, across 0 downwards on F+ or G upwards on F−). [`torque`] is
+//! the same gear pair with the main shaft an inertia driven by a torque (torque mode).
 #![allow(non_snake_case)]
+
+pub mod torque;
 
 use serde::{Deserialize, Serialize};
 
 use crate::integrator::{Edge, Jacobian, Piecewise, System, Tolerance};
-use crate::physics::{Dynamics, Excitation, Region};
+use crate::physics::{Dynamics, Excitation, GearParams, Region, Shaft};
 
 /// Components of the state vector.
 pub const XI: usize = 0;
@@ -56,15 +59,68 @@ impl Rattle {
     /// contact's speed scale: with hard contacts (K* = 1e10) that looser floor let ξ drift by
     /// 100 rtol per flight. The energies are quadratures outside the error control.
     pub fn tolerance(&self, rtol: f64) -> Tolerance<N> {
-        const FLIGHT_RATE: f64 = 1e3;
-        let p = &self.dynamics.params;
-        let xi_scale = p.G;
-        let xi_dot_scale = p.G * p.contact_frequency().min(FLIGHT_RATE);
+        let (xi_scale, xi_dot_scale) = scales(&self.dynamics.params);
         Tolerance {
             rtol,
             atol: [rtol * xi_scale, rtol * xi_dot_scale, 0.0, 0.0, 0.0],
             controlled: 2,
         }
+    }
+}
+
+/// What the co-simulation reads from the gear pair whatever drives its main shaft: ξ and ξ'
+/// are the components `GUARD` and `RATE`; the dissipated energies sit at `E_CONTACT` and
+/// `E_LUBRICANT`.
+pub trait GearPair<const N: usize>: Piecewise<N> {
+    const E_CONTACT: usize;
+    const E_LUBRICANT: usize;
+    fn dynamics(&self) -> &Dynamics;
+    fn region(&self) -> Region;
+    fn impacts(&self) -> &Impacts;
+    /// θ_M, ω_M and a_M of the main shaft at (t, y).
+    fn shaft(&self, t: f64, y: &[f64; N]) -> Shaft;
+}
+
+impl GearPair<N> for Rattle {
+    const E_CONTACT: usize = E_CONTACT;
+    const E_LUBRICANT: usize = E_LUBRICANT;
+    fn dynamics(&self) -> &Dynamics {
+        &self.dynamics
+    }
+    fn region(&self) -> Region {
+        self.region
+    }
+    fn impacts(&self) -> &Impacts {
+        &self.impacts
+    }
+    fn shaft(&self, t: f64, _y: &State) -> Shaft {
+        self.excitation.at(t)
+    }
+}
+
+/// Scales of ξ and ξ' for the error weights (see [`Rattle::tolerance`]).
+pub(crate) fn scales(p: &GearParams) -> (f64, f64) {
+    const FLIGHT_RATE: f64 = 1e3;
+    (p.G, p.G * p.contact_frequency().min(FLIGHT_RATE))
+}
+
+/// The region entered through `edge`; an onset counted in `impacts` when it leaves the gap.
+pub(crate) fn cross_edge(
+    dynamics: &Dynamics,
+    region: Region,
+    impacts: &mut Impacts,
+    edge: Edge,
+    xi_dot: f64,
+) -> Region {
+    let law = &dynamics.law;
+    if region == Region::Gap {
+        let flank = if edge == Edge::Lower { 0 } else { 1 };
+        impacts.count[flank] += 1;
+        impacts.last_speed = xi_dot.abs();
+    }
+    match edge {
+        Edge::Lower => law.below(region),
+        Edge::Upper => law.above(region),
     }
 }
 
@@ -116,17 +172,13 @@ impl Piecewise<N> for Rattle {
     }
 
     fn cross(&mut self, edge: Edge, _t: f64, y: &State) {
-        let law = &self.dynamics.law;
-        let next = match edge {
-            Edge::Lower => law.below(self.region),
-            Edge::Upper => law.above(self.region),
-        };
-        if self.region == Region::Gap {
-            let flank = if edge == Edge::Lower { 0 } else { 1 };
-            self.impacts.count[flank] += 1;
-            self.impacts.last_speed = y[XI_DOT].abs();
-        }
-        self.region = next;
+        self.region = cross_edge(
+            &self.dynamics,
+            self.region,
+            &mut self.impacts,
+            edge,
+            y[XI_DOT],
+        );
     }
 }
 

@@ -257,7 +257,7 @@ impl Instance {
         let mut shaft_changed = false;
         for (vr, value) in vrs.iter().zip(values) {
             self.values.set_real(*vr, *value);
-            shaft_changed |= matches!(*vr, vr::theta_M | vr::omega_M | vr::alpha_M);
+            shaft_changed |= matches!(*vr, vr::theta_M | vr::omega_M | vr::alpha_M | vr::tau_in);
         }
         if shaft_changed || self.state != FmiState::StepComplete {
             self.inputs_changed();
@@ -266,7 +266,8 @@ impl Instance {
     }
 
     /// After new values: rebuild the initial state during initialisation, or hand the main
-    /// shaft's new motion to the running simulation (inputs take effect at once).
+    /// shaft's new motion (inputs mode) or torque (torque mode) to the running simulation
+    /// (inputs take effect at once).
     fn inputs_changed(&mut self) {
         match self.state {
             FmiState::StepComplete => {
@@ -275,10 +276,12 @@ impl Instance {
                     omega: self.values.real(vr::omega_M),
                     alpha: self.values.real(vr::alpha_M),
                 };
+                let (tau, rate) = (self.values.real(vr::tau_in), self.values.tau_in_rate());
                 let sim = self.sim.as_mut().expect("initialised");
-                let before = sim.rattle.impacts;
+                let before = sim.impacts();
                 sim.set_shaft(shaft);
-                if before != sim.rattle.impacts {
+                sim.set_torque(tau, rate);
+                if before != sim.impacts() {
                     self.log(Status::Ok, EVENTS, || {
                         "new inputs moved the gear pair across a contact onset".to_string()
                     });
@@ -291,7 +294,9 @@ impl Instance {
 
     /// fmi2SetRealInputDerivatives: the derivatives of θ_M (orders 1, 2) and ω_M (order 1) at
     /// the start of the next step set the speed and acceleration of the main shaft's Taylor
-    /// polynomial over the step (a later call for the same quantity wins).
+    /// polynomial over the step (a later call for the same quantity wins); the derivative of
+    /// τ_in (order 1) ramps the torque over the step (torque mode). Like the inputs, a
+    /// derivative holds until it is set again.
     pub fn set_input_derivatives(
         &mut self,
         vrs: &[u32],
@@ -300,13 +305,15 @@ impl Instance {
     ) -> FmiResult {
         let mut targets = Vec::with_capacity(vrs.len());
         for ((vr, order), value) in vrs.iter().zip(orders).zip(values) {
+            // Where the derivative is kept: an input variable, or τ_in's rate (None).
             let target = match (*vr, *order) {
-                (vr::theta_M, 1) => vr::omega_M,
-                (vr::theta_M, 2) | (vr::omega_M, 1) => vr::alpha_M,
+                (vr::theta_M, 1) => Some(vr::omega_M),
+                (vr::theta_M, 2) | (vr::omega_M, 1) => Some(vr::alpha_M),
+                (vr::tau_in, 1) => None,
                 _ => {
                     let name = contract::find(Kind::Real, *vr).map_or("?", |v| v.name);
                     return Err(FmiError::error(format!(
-                        "derivative of order {order} of value reference {vr} ({name}) is not an input derivative of this model: theta_M takes orders 1 and 2, omega_M order 1"
+                        "derivative of order {order} of value reference {vr} ({name}) is not an input derivative of this model: theta_M takes orders 1 and 2, omega_M and tau_in order 1"
                     )));
                 }
             };
@@ -318,7 +325,10 @@ impl Instance {
             targets.push((target, *value));
         }
         for (target, value) in targets {
-            self.values.set_real(target, value);
+            match target {
+                Some(vr) => self.values.set_real(vr, value),
+                None => self.values.set_tau_in_rate(value),
+            }
         }
         self.inputs_changed();
         Ok(())
@@ -359,7 +369,7 @@ impl Instance {
             let var = Self::variable(Kind::Real, *k)?;
             if var.causality != Causality::Input {
                 return Err(FmiError::error(format!(
-                    "{} is not an input: directional derivatives are taken with respect to theta_M, omega_M, alpha_M",
+                    "{} is not an input: directional derivatives are taken with respect to theta_M, omega_M, alpha_M, tau_in",
                     var.name
                 )));
             }
@@ -406,14 +416,17 @@ impl Instance {
         }
     }
 
-    /// Main inputs coherent with the previous values: `theta_M` and `omega_M` follow the
-    /// extrapolation when the master does not set them again (see `Simulation::step_to`).
+    /// Main inputs coherent with the previous values: `theta_M` and `omega_M` (inputs mode)
+    /// or `tau_in` (torque mode) follow the extrapolation when the master does not set them
+    /// again (see `Simulation::step_to`).
     fn sync_inputs(&mut self) {
-        if let Some(sim) = &self.sim {
-            if let simulation::Drive::Inputs(shaft) = sim.drive {
+        match self.sim.as_ref().map(|sim| sim.drive) {
+            Some(simulation::Drive::Inputs(shaft)) => {
                 self.values.set_real(vr::theta_M, shaft.theta);
                 self.values.set_real(vr::omega_M, shaft.omega);
             }
+            Some(simulation::Drive::Torque { tau, .. }) => self.values.set_real(vr::tau_in, tau),
+            _ => {}
         }
     }
 
@@ -439,19 +452,15 @@ impl Instance {
                 self.last_successful_time = t_end;
                 self.sync_inputs();
                 let sim = self.sim.as_ref().expect("initialised");
-                let (stats, impacts, h_next) = (
-                    sim.solver.stats,
-                    sim.rattle.impacts,
-                    sim.solver.proposed_step(),
-                );
-                let method = if sim.solver.is_implicit() {
+                let (stats, impacts, h_next) = (sim.stats(), sim.impacts(), sim.proposed_step());
+                let method = if sim.is_implicit() {
                     "Radau IIA"
                 } else {
                     "DOPRI5"
                 };
                 let new = [
-                    impacts.count[0] - before.rattle.impacts.count[0],
-                    impacts.count[1] - before.rattle.impacts.count[1],
+                    impacts.count[0] - before.impacts().count[0],
+                    impacts.count[1] - before.impacts().count[1],
                 ];
                 if new != [0, 0] {
                     self.log(Status::Ok, EVENTS, || {
@@ -461,7 +470,7 @@ impl Instance {
                         )
                     });
                 }
-                if stats.switches != before.solver.stats.switches {
+                if stats.switches != before.stats().switches {
                     self.log(Status::Ok, EVENTS, || {
                         format!("t = {t_end}: integration method handed over, now {method}")
                     });

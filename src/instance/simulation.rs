@@ -1,5 +1,9 @@
-//! The running model of an initialised instance: the rattle, its solver, the clock, the
-//! state, and what drives the main shaft. Outputs are computed here when they are read.
+//! The running model of an initialised instance: the gear pair with its solver and state,
+//! the clock, and what drives the main shaft. Two couplings: kinematic (the shaft's motion
+//! imposed by the bench sine or the master's inputs; the 5-component [`Rattle`]) and torque
+//! (the shaft an inertia driven by the master's torque; the 7-component [`TorqueRattle`]),
+//! each with a solver of its own size, so the kinematic modes carry no extra state.
+//! Outputs are computed here when they are read, by one code for both couplings ([`Now`]).
 #![allow(non_snake_case)]
 
 use serde::{Deserialize, Serialize};
@@ -7,25 +11,17 @@ use serde::{Deserialize, Serialize};
 use super::error::{FmiError, FmiResult};
 use super::values::Values;
 use crate::contract::vr;
-use crate::integrator::{Method, Piecewise, Solver, SolverError};
-use crate::physics::{Dynamics, Excitation, GearParams, Polynomial, Shaft, Sine};
-use crate::rattle::{self, E_CONTACT, E_LUBRICANT, Rattle, State, XI, XI_DOT};
+use crate::integrator::{Jacobian, Method, Piecewise, Solver, SolverError, Stats};
+use crate::physics::{
+    Dynamics, Excitation, GearParams, MainShaft, Polynomial, Region, Shaft, Sine, TorqueRamp,
+};
+use crate::rattle::torque::{self, TorqueRattle};
+use crate::rattle::{self, GearPair, Impacts, Rattle};
 
 /// Values of the `excitation` parameter.
 pub const EXCITATION_INPUTS: i64 = 0;
 pub const EXCITATION_SINE: i64 = 1;
-
-/// Values of the `solver` parameter.
-fn method(values: &Values) -> FmiResult<Method> {
-    match values.integer(vr::solver) {
-        0 => Ok(Method::Auto),
-        1 => Ok(Method::Explicit),
-        2 => Ok(Method::Implicit),
-        other => Err(FmiError::error(format!(
-            "parameter solver = {other} is invalid: allowed 0 (auto), 1 (DOPRI5) or 2 (Radau IIA)"
-        ))),
-    }
-}
+pub const EXCITATION_TORQUE: i64 = 2;
 
 /// What moves the main shaft.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -35,16 +31,78 @@ pub enum Drive {
     /// The drivetrain's inputs: the shaft's motion at the current time, extrapolated over
     /// each step as a Taylor polynomial (MODEL.md §5: never a zero-order hold).
     Inputs(Shaft),
+    /// The drivetrain's torque on the shaft τ_in at the current time and its rate, ramped
+    /// over each step; the shaft's motion follows from I_M ω_M' = τ_in + τ_M.
+    Torque { tau: f64, rate: f64 },
+}
+
+/// A piecewise system with its solver and its state.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Stepped<S, const N: usize> {
+    pub system: S,
+    pub solver: Solver<N>,
+    #[serde(with = "crate::integrator::serde_array")]
+    pub y: [f64; N],
+}
+
+impl<S: GearPair<N> + Jacobian<N>, const N: usize> Stepped<S, N> {
+    fn advance(&mut self, t: &mut f64, t_end: f64) -> Result<(), SolverError> {
+        self.solver.advance(&mut self.system, t, &mut self.y, t_end)
+    }
+
+    fn now(&self) -> Now<'_> {
+        let (sys, y) = (&self.system, &self.y);
+        Now {
+            dynamics: sys.dynamics(),
+            region: sys.region(),
+            impacts: sys.impacts(),
+            xi: y[S::GUARD],
+            xi_dot: y[S::RATE],
+            e_contact: y[S::E_CONTACT],
+            e_lubricant: y[S::E_LUBRICANT],
+            stats: self.solver.stats,
+            implicit: self.solver.is_implicit(),
+        }
+    }
+}
+
+/// The gear pair in one of the two couplings.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub enum Gear {
+    /// The main shaft's motion imposed (sine or inputs): state ξ, ξ' and the quadratures.
+    Kinematic(Stepped<Rattle, { rattle::N }>),
+    /// The main shaft an inertia driven by τ_in: θ_M and ω_M join the state.
+    Torque(Stepped<TorqueRattle, { torque::N }>),
 }
 
 /// An initialised gear pair being stepped.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Simulation {
-    pub rattle: Rattle,
-    pub solver: Solver<{ rattle::N }>,
+    pub gear: Gear,
     pub t: f64,
-    pub y: State,
     pub drive: Drive,
+}
+
+/// What every output is computed from at the current time, whichever the coupling (the
+/// shaft's motion apart: [`Simulation::shaft`], computed only for the outputs that need it).
+struct Now<'a> {
+    dynamics: &'a Dynamics,
+    region: Region,
+    impacts: &'a Impacts,
+    xi: f64,
+    xi_dot: f64,
+    e_contact: f64,
+    e_lubricant: f64,
+    stats: Stats,
+    /// Radau IIA is stepping now.
+    implicit: bool,
+}
+
+impl Now<'_> {
+    fn loads(&self, shaft: &Shaft) -> crate::physics::Loads {
+        self.dynamics
+            .loads(self.region, self.xi, self.xi_dot, shaft)
+    }
 }
 
 fn param(values: &Values, vr: u32) -> f64 {
@@ -68,6 +126,18 @@ pub fn gear_params(values: &Values) -> GearParams {
     }
 }
 
+/// The integration method the `solver` parameter asks for.
+fn method(values: &Values) -> FmiResult<Method> {
+    match values.integer(vr::solver) {
+        0 => Ok(Method::Auto),
+        1 => Ok(Method::Explicit),
+        2 => Ok(Method::Implicit),
+        other => Err(FmiError::error(format!(
+            "parameter solver = {other} is invalid: allowed 0 (auto), 1 (DOPRI5) or 2 (Radau IIA)"
+        ))),
+    }
+}
+
 /// Checks that a parameter outside the gear's nine is finite and within its range.
 fn check(name: &str, value: f64, ok: bool, allowed: &str) -> FmiResult {
     if value.is_finite() && ok {
@@ -81,7 +151,8 @@ fn check(name: &str, value: f64, ok: bool, allowed: &str) -> FmiResult {
 
 impl Simulation {
     /// Validates the parameters and builds the initial state at t0 (MODEL.md §1:
-    /// ξ(0) = gap_start·G, ξ'(0) = xi_dot_start).
+    /// ξ(0) = gap_start·G, ξ'(0) = xi_dot_start; in torque mode the shaft starts from the
+    /// values of the inputs theta_M and omega_M, θ_M(0) = theta_M, ω_M(0) = omega_M).
     pub fn new(values: &Values, t0: f64, rtol: f64) -> FmiResult<Self> {
         let params = gear_params(values);
         params
@@ -92,45 +163,70 @@ impl Simulation {
         let omega_mean = param(values, vr::omega_mean);
         let gap_start = param(values, vr::gap_start);
         let xi_dot_start = param(values, vr::xi_dot_start);
+        let I_M = param(values, vr::I_M);
         check("f_exc", f_exc, f_exc > 0.0, "finite and > 0")?;
         check("A_rms", a_rms, true, "finite")?;
         check("omega_mean", omega_mean, true, "finite")?;
         check("gap_start", gap_start, true, "finite")?;
         check("xi_dot_start", xi_dot_start, true, "finite")?;
+        check("I_M", I_M, I_M > 0.0, "finite and > 0")?;
+        let shaft = Shaft {
+            theta: param(values, vr::theta_M),
+            omega: param(values, vr::omega_M),
+            alpha: param(values, vr::alpha_M),
+        };
         let drive = match values.integer(vr::excitation) {
-            EXCITATION_INPUTS => Drive::Inputs(Shaft {
-                theta: param(values, vr::theta_M),
-                omega: param(values, vr::omega_M),
-                alpha: param(values, vr::alpha_M),
-            }),
+            EXCITATION_INPUTS => Drive::Inputs(shaft),
             EXCITATION_SINE => Drive::Sine(Sine::new(a_rms, f_exc, omega_mean)),
+            EXCITATION_TORQUE => Drive::Torque {
+                tau: param(values, vr::tau_in),
+                rate: values.tau_in_rate(),
+            },
             other => {
                 return Err(FmiError::error(format!(
-                    "parameter excitation = {other} is invalid: allowed 0 (inputs) or 1 (sine)"
+                    "parameter excitation = {other} is invalid: allowed 0 (inputs), 1 (sine) or 2 (torque)"
                 )));
             }
         };
+        let method = method(values)?;
         let dynamics = Dynamics::new(params);
         let xi = gap_start * params.G;
-        let excitation = Self::excitation_from(drive, t0);
-        let rattle = Rattle::new(dynamics, excitation, xi);
-        let mut y = [0.0; rattle::N];
-        y[XI] = xi;
-        y[XI_DOT] = xi_dot_start;
-        let mut solver = Solver::with_method(rattle.tolerance(rtol), method(values)?);
-        // The bench's sine does not change between steps: communication points are served
-        // from the dense output of natural steps. Inputs change at every step: steps end on
-        // the communication points, where the new inputs apply.
-        solver.interpolate_ends = matches!(drive, Drive::Sine(_));
-        Ok(Simulation {
-            solver,
-            rattle,
-            t: t0,
-            y,
-            drive,
-        })
+        let gear = match drive {
+            Drive::Torque { tau, rate } => {
+                let ramp = TorqueRamp {
+                    t0,
+                    tau0: tau,
+                    rate,
+                };
+                let system = TorqueRattle::new(dynamics, MainShaft { I_M }, ramp, xi);
+                let mut y = [0.0; torque::N];
+                y[torque::XI] = xi;
+                y[torque::XI_DOT] = xi_dot_start;
+                y[torque::THETA_M] = shaft.theta;
+                y[torque::OMEGA_M] = shaft.omega;
+                Gear::Torque(Stepped {
+                    solver: Solver::with_method(system.tolerance(rtol), method),
+                    system,
+                    y,
+                })
+            }
+            _ => {
+                let system = Rattle::new(dynamics, Self::excitation_from(drive, t0), xi);
+                let mut y = [0.0; rattle::N];
+                y[rattle::XI] = xi;
+                y[rattle::XI_DOT] = xi_dot_start;
+                let mut solver = Solver::with_method(system.tolerance(rtol), method);
+                // The bench's sine does not change between steps: communication points are
+                // served from the dense output of natural steps. Inputs change at every step:
+                // steps end on the communication points, where the new inputs apply.
+                solver.interpolate_ends = matches!(drive, Drive::Sine(_));
+                Gear::Kinematic(Stepped { solver, system, y })
+            }
+        };
+        Ok(Simulation { gear, t: t0, drive })
     }
 
+    /// The imposed motion of the shaft for a kinematic drive.
     fn excitation_from(drive: Drive, t: f64) -> Excitation {
         match drive {
             Drive::Sine(s) => Excitation::Sine(s),
@@ -138,68 +234,126 @@ impl Simulation {
                 t0: t,
                 at_t0: shaft,
             }),
+            Drive::Torque { .. } => unreachable!("the torque mode has no imposed motion"),
         }
     }
 
-    /// The main shaft's motion now.
+    /// The state the outputs are computed from, now.
+    fn now(&self) -> Now<'_> {
+        match &self.gear {
+            Gear::Kinematic(k) => k.now(),
+            Gear::Torque(k) => k.now(),
+        }
+    }
+
+    /// The main shaft's motion now (in torque mode α_M follows from τ_in and the contact).
     pub fn shaft(&self) -> Shaft {
-        self.rattle.excitation.at(self.t)
+        match &self.gear {
+            Gear::Kinematic(k) => k.system.shaft(self.t, &k.y),
+            Gear::Torque(k) => k.system.shaft(self.t, &k.y),
+        }
+    }
+
+    /// Impacts counted so far.
+    pub fn impacts(&self) -> Impacts {
+        *self.now().impacts
+    }
+
+    /// The solver's work counters.
+    pub fn stats(&self) -> Stats {
+        self.now().stats
+    }
+
+    /// True while Radau IIA steps.
+    pub fn is_implicit(&self) -> bool {
+        self.now().implicit
+    }
+
+    /// Step size the next internal step will try.
+    pub fn proposed_step(&self) -> f64 {
+        match &self.gear {
+            Gear::Kinematic(k) => k.solver.proposed_step(),
+            Gear::Torque(k) => k.solver.proposed_step(),
+        }
     }
 
     /// New input values for the main shaft (inputs mode). The loose gear does not move, so
     /// ξ and ξ' follow the shaft (ξ = r_L θ_L − r_M θ_M): reading them right after reflects
-    /// the new inputs (direct feedthrough). In sine mode the inputs are not used.
+    /// the new inputs (direct feedthrough). In the other modes the inputs are not used.
     pub fn set_shaft(&mut self, shaft: Shaft) {
-        let Drive::Inputs(old) = self.drive else {
+        let (Drive::Inputs(old), Gear::Kinematic(k)) = (self.drive, &mut self.gear) else {
             return;
         };
-        let r_M = self.rattle.dynamics.params.r_M;
-        self.y[XI] += r_M * (old.theta - shaft.theta);
-        self.y[XI_DOT] += r_M * (old.omega - shaft.omega);
+        let r_M = k.system.dynamics.params.r_M;
+        k.y[rattle::XI] += r_M * (old.theta - shaft.theta);
+        k.y[rattle::XI_DOT] += r_M * (old.omega - shaft.omega);
         self.drive = Drive::Inputs(shaft);
-        self.rattle.excitation = Self::excitation_from(self.drive, self.t);
-        self.rattle.settle(self.t, &self.y);
-        self.solver.invalidate();
+        k.system.excitation = Self::excitation_from(self.drive, self.t);
+        k.system.settle(self.t, &k.y);
+        k.solver.invalidate();
+    }
+
+    /// New torque on the main shaft and its rate (torque mode; ignored otherwise). The state
+    /// does not jump: only the shaft's acceleration, read at once as alpha_M_out, changes.
+    pub fn set_torque(&mut self, tau: f64, rate: f64) {
+        let (Drive::Torque { .. }, Gear::Torque(k)) = (self.drive, &mut self.gear) else {
+            return;
+        };
+        self.drive = Drive::Torque { tau, rate };
+        k.system.torque = TorqueRamp {
+            t0: self.t,
+            tau0: tau,
+            rate,
+        };
+        k.solver.invalidate();
     }
 
     /// Advances to t_end. On failure the simulation is left as it was.
     pub fn step_to(&mut self, t_end: f64) -> Result<(), SolverError> {
-        let mut next = *self;
-        next.solver
-            .advance(&mut next.rattle, &mut next.t, &mut next.y, t_end)?;
-        next.t = t_end;
-        if let Drive::Inputs(_) = next.drive {
-            // The shaft continues along its extrapolation unless the master sets new inputs.
-            next.drive = Drive::Inputs(next.rattle.excitation.at(t_end));
+        let before = *self;
+        let advanced = match &mut self.gear {
+            Gear::Kinematic(k) => k.advance(&mut self.t, t_end),
+            Gear::Torque(k) => k.advance(&mut self.t, t_end),
+        };
+        if let Err(e) = advanced {
+            *self = before;
+            return Err(e);
         }
-        *self = next;
+        self.t = t_end;
+        // The inputs continue along their extrapolation unless the master sets new ones.
+        match (&mut self.drive, &self.gear) {
+            (Drive::Inputs(shaft), Gear::Kinematic(k)) => *shaft = k.system.excitation.at(t_end),
+            (Drive::Torque { tau, .. }, Gear::Torque(k)) => *tau = k.system.torque.at(t_end),
+            _ => {}
+        }
         Ok(())
     }
 
     /// The value of a Real output, computed now; None if `vr` is not a Real output.
     pub fn real_output(&self, vr: u32) -> Option<f64> {
-        let dynamics = &self.rattle.dynamics;
-        let shaft = self.shaft();
-        let loads = || dynamics.loads(self.rattle.region, self.y[XI], self.y[XI_DOT], &shaft);
+        let now = self.now();
+        let dynamics = now.dynamics;
+        let shaft = || self.shaft();
+        let loads = || now.loads(&shaft());
         Some(match vr {
-            vr::theta_L => dynamics.theta_L(self.y[XI], &shaft),
+            vr::theta_L => dynamics.theta_L(now.xi, &shaft()),
             vr::omega_L => loads().omega_L,
             vr::alpha_L => loads().alpha_L,
             vr::a_pitch_L => dynamics.params.r_L * loads().alpha_L,
-            vr::xi => self.y[XI],
-            vr::xi_dot => self.y[XI_DOT],
+            vr::xi => now.xi,
+            vr::xi_dot => now.xi_dot,
             vr::F_contact => loads().force.total(),
             vr::tau_M => dynamics.tau_M(&loads()),
-            vr::impact_speed => self.rattle.impacts.last_speed,
-            vr::E_contact => self.y[E_CONTACT],
-            vr::E_lubricant => self.y[E_LUBRICANT],
-            vr::theta_M_out => shaft.theta,
-            vr::omega_M_out => shaft.omega,
-            vr::alpha_M_out => shaft.alpha,
-            vr::solver_steps => self.solver.stats.accepted as f64,
-            vr::solver_rejected => self.solver.stats.rejected as f64,
-            vr::solver_rhs => self.solver.stats.rhs_evals as f64,
-            vr::solver_implicit_steps => self.solver.stats.implicit_steps as f64,
+            vr::impact_speed => now.impacts.last_speed,
+            vr::E_contact => now.e_contact,
+            vr::E_lubricant => now.e_lubricant,
+            vr::theta_M_out => shaft().theta,
+            vr::omega_M_out => shaft().omega,
+            vr::alpha_M_out => shaft().alpha,
+            vr::solver_steps => now.stats.accepted as f64,
+            vr::solver_rejected => now.stats.rejected as f64,
+            vr::solver_rhs => now.stats.rhs_evals as f64,
+            vr::solver_implicit_steps => now.stats.implicit_steps as f64,
             _ => return None,
         })
     }
@@ -207,13 +361,14 @@ impl Simulation {
     /// First time derivative of a Real output (maxOutputDerivativeOrder = 1), from the
     /// equations of motion at the current state; None where the model has none to give.
     pub fn real_output_derivative(&self, vr: u32) -> Option<f64> {
-        let dynamics = &self.rattle.dynamics;
+        let now = self.now();
+        let dynamics = now.dynamics;
         let p = &dynamics.params;
         let shaft = self.shaft();
-        let (xi, xi_dot) = (self.y[XI], self.y[XI_DOT]);
-        let loads = dynamics.loads(self.rattle.region, xi, xi_dot, &shaft);
+        let (xi, xi_dot) = (now.xi, now.xi_dot);
+        let loads = now.loads(&shaft);
         let force_rate = || {
-            let slopes = dynamics.law.slopes(self.rattle.region, xi, xi_dot);
+            let slopes = dynamics.law.slopes(now.region, xi, xi_dot);
             slopes.d_xi * xi_dot + slopes.d_xi_dot * loads.xi_ddot
         };
         Some(match vr {
@@ -230,18 +385,26 @@ impl Simulation {
     }
 
     /// ∂output/∂input at the current state: how an output read right after new inputs moves
-    /// with them (direct feedthrough; MODEL.md §3 with ξ = r_L θ_L − r_M θ_M at fixed θ_L).
-    /// Zero for inputs the current excitation does not use. ∂τ_M/∂θ_M and ∂τ_M/∂ω_M are the
-    /// coupling stiffness and damping a master sees.
+    /// with them (direct feedthrough). Zero for inputs the current excitation does not use.
     pub fn partial(&self, output: u32, input: u32) -> f64 {
-        if !matches!(self.drive, Drive::Inputs(_)) {
-            return 0.0;
+        match (self.drive, &self.gear) {
+            (Drive::Inputs(_), _) => self.kinematic_partial(output, input),
+            // Torque mode: τ_in moves only the shaft's acceleration at once,
+            // α_M = (τ_in + τ_M) / I_M; the state (ξ, ξ', θ_M, ω_M) does not jump.
+            (Drive::Torque { .. }, Gear::Torque(k)) => match (output, input) {
+                (vr::alpha_M_out, vr::tau_in) => 1.0 / k.system.main.I_M,
+                _ => 0.0,
+            },
+            _ => 0.0,
         }
-        let dynamics = &self.rattle.dynamics;
-        let p = &dynamics.params;
-        let slopes = dynamics
-            .law
-            .slopes(self.rattle.region, self.y[XI], self.y[XI_DOT]);
+    }
+
+    /// Inputs mode (MODEL.md §3 with ξ = r_L θ_L − r_M θ_M at fixed θ_L). ∂τ_M/∂θ_M and
+    /// ∂τ_M/∂ω_M are the coupling stiffness and damping a master sees.
+    fn kinematic_partial(&self, output: u32, input: u32) -> f64 {
+        let now = self.now();
+        let p = &now.dynamics.params;
+        let slopes = now.dynamics.law.slopes(now.region, now.xi, now.xi_dot);
         // ∂ξ/∂θ_M = −r_M and ∂ξ'/∂ω_M = −r_M; ∂F follows through the contact law.
         let d_force = match input {
             vr::theta_M => -p.r_M * slopes.d_xi,
@@ -263,13 +426,14 @@ impl Simulation {
 
     /// The value of an Integer output; None if `vr` is not an Integer output.
     pub fn integer_output(&self, vr: u32) -> Option<i64> {
-        let count = &self.rattle.impacts.count;
+        let now = self.now();
+        let count = &now.impacts.count;
         Some(match vr {
-            vr::contact => self.rattle.region.flank() as i64,
+            vr::contact => now.region.flank() as i64,
             vr::impacts_Fplus => count[0] as i64,
             vr::impacts_Fminus => count[1] as i64,
             vr::solver_method => {
-                if self.solver.is_implicit() {
+                if now.implicit {
                     2
                 } else {
                     1

@@ -1,5 +1,6 @@
 //! The values of parameters and inputs as last set, indexed by value reference, starting
-//! from the contract's start values.
+//! from the contract's start values, and the one input derivative without a variable of its
+//! own (dτ_in/dt; the derivatives of θ_M and ω_M are stored as omega_M and alpha_M).
 
 use serde::{Deserialize, Serialize};
 
@@ -9,6 +10,8 @@ use crate::contract::{Kind, Start, VARIABLES};
 pub struct Values {
     real: Vec<f64>,
     integer: Vec<i64>,
+    /// dτ_in/dt from fmi2SetRealInputDerivatives [N m/s] (0 until set: a held torque).
+    tau_in_rate: f64,
 }
 
 impl Values {
@@ -25,6 +28,7 @@ impl Values {
         let mut values = Values {
             real: vec![0.0; size(Kind::Real)],
             integer: vec![0; size(Kind::Integer)],
+            tau_in_rate: 0.0,
         };
         for v in VARIABLES {
             match v.start {
@@ -47,6 +51,14 @@ impl Values {
     /// Stores a value; `vr` must be a Real variable of the contract.
     pub fn set_real(&mut self, vr: u32, value: f64) {
         self.real[vr as usize] = value;
+    }
+
+    pub fn tau_in_rate(&self) -> f64 {
+        self.tau_in_rate
+    }
+
+    pub fn set_tau_in_rate(&mut self, rate: f64) {
+        self.tau_in_rate = rate;
     }
 
     /// Stores a value; `vr` must be an Integer variable of the contract.

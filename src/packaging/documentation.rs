@@ -36,6 +36,14 @@ communication point; within the step the FMU extrapolates θ_M + ω_M τ + α_M 
 zero-order hold, which would make ξ jump by r_M ω_M h). An input the master does not set again
 continues along that extrapolation. Setting new inputs moves ξ and ξ' at once (the loose gear
 does not move), so outputs read right after reflect them.</p>
+<p><code>excitation = 2</code> (torque): the main shaft is a rigid inertia I_M driven by the
+drivetrain's torque <code>tau_in</code> and by the contact's reaction,
+<code>I_M ω_M' = τ_in + τ_M</code> with <code>τ_M = r_M F</code>; θ_M and ω_M are integrated with
+the gear pair, starting from the values of the inputs theta_M and omega_M at
+fmi2ExitInitializationMode, and come out as theta_M_out, omega_M_out, alpha_M_out.
+τ_in is held over the step, or ramped with its first derivative
+(fmi2SetRealInputDerivatives); a new τ_in moves alpha_M_out at once by Δτ_in / I_M. With
+C = C_LM = B = 0, <code>½ I_L ω_L² + ½ I_M ω_M² + V(ξ) − ∫ τ_in ω_M dt</code> is constant.</p>
 <h2>Use from fmpy</h2>
 <pre>from fmpy import simulate_fmu
 r = simulate_fmu("GearRattle.fmu", stop_time=1.0, output_interval=1e-5,

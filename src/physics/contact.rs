@@ -231,16 +231,11 @@ pub struct ForceSlopes {
 }
 
 impl ContactLaw {
-    /// ∂F/∂ξ and ∂F/∂ξ' with the formula of `region`: the contact's instantaneous stiffness
-    /// and damping along ξ (s' = (π/2ε) sin(π δ/ε) inside a band).
-    pub fn slopes(&self, region: Region, xi: f64, xi_dot: f64) -> ForceSlopes {
-        let (s, ds, delta) = match region {
-            Region::Gap => {
-                return ForceSlopes {
-                    d_xi: 0.0,
-                    d_xi_dot: 0.0,
-                };
-            }
+    /// s, ds/dξ and the penetration δ with the formula of `region`; None in the gap (s = 0).
+    #[inline]
+    fn blend(&self, region: Region, xi: f64) -> Option<(f64, f64, f64)> {
+        Some(match region {
+            Region::Gap => return None,
             Region::ContactPlus => (1.0, 0.0, xi),
             Region::ContactMinus => (1.0, 0.0, xi - self.G),
             Region::BandPlus | Region::BandMinus => {
@@ -252,11 +247,34 @@ impl ContactLaw {
                 let ds = self.half_pi_over_eps * (2.0 * self.half_pi_over_eps * delta).sin();
                 (self.smoothing(delta), ds, delta)
             }
+        })
+    }
+
+    /// ∂F/∂ξ and ∂F/∂ξ' with the formula of `region`: the contact's instantaneous stiffness
+    /// and damping along ξ (s' = (π/2ε) sin(π δ/ε) inside a band).
+    pub fn slopes(&self, region: Region, xi: f64, xi_dot: f64) -> ForceSlopes {
+        let Some((s, ds, delta)) = self.blend(region, xi) else {
+            return ForceSlopes {
+                d_xi: 0.0,
+                d_xi_dot: 0.0,
+            };
         };
         let stiffening = self.stiffening(delta);
         let unsmoothed = self.K_star * (delta * stiffening) + self.C_LM * xi_dot;
         ForceSlopes {
             d_xi: ds * unsmoothed + s * self.K_star * (self.alpha() * stiffening),
+            d_xi_dot: s * self.C_LM,
+        }
+    }
+
+    /// ∂F_c/∂ξ and ∂F_c/∂ξ' of the dissipative part alone, F_c = s C_LM ξ' (for the
+    /// Jacobian of the dissipated energy's quadrature).
+    pub fn dissipative_slopes(&self, region: Region, xi: f64, xi_dot: f64) -> ForceSlopes {
+        let (s, ds) = self
+            .blend(region, xi)
+            .map_or((0.0, 0.0), |(s, ds, _)| (s, ds));
+        ForceSlopes {
+            d_xi: ds * self.C_LM * xi_dot,
             d_xi_dot: s * self.C_LM,
         }
     }
@@ -303,6 +321,14 @@ mod tests {
                     "{alpha} {xi:e}"
                 );
                 assert!((slopes.d_xi_dot - d_v).abs() <= 1e-6 * d_v.abs().max(1.0));
+                let fc = |x: f64| law.force(region, x, v).dissipative;
+                let dc = law.dissipative_slopes(region, xi, v);
+                let dc_xi = (fc(xi + h) - fc(xi - h)) / (2.0 * h);
+                assert!(
+                    (dc.d_xi - dc_xi).abs() <= 1e-4 * dc_xi.abs().max(1.0),
+                    "{alpha} {xi:e}"
+                );
+                assert_eq!(dc.d_xi_dot, law.force(region, xi, 1.0).dissipative);
             }
         }
     }

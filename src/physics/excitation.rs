@@ -1,5 +1,6 @@
 //! Motion of the main shaft (MODEL.md §5): the paper's bench sine, or a polynomial
-//! extrapolation of the drivetrain's inputs over a communication step.
+//! extrapolation of the drivetrain's inputs over a communication step; in torque mode, the
+//! drivetrain's torque on the shaft, extrapolated linearly over the step.
 
 use serde::{Deserialize, Serialize};
 
@@ -60,6 +61,24 @@ impl Polynomial {
             omega: s.omega + tau * s.alpha,
             alpha: s.alpha,
         }
+    }
+}
+
+/// Torque mode: the torque τ_in the drivetrain applies to the main shaft, τ0 + τ̇ (t − t0)
+/// over a step (τ̇ from fmi2SetRealInputDerivatives, else 0: a hold).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TorqueRamp {
+    pub t0: f64,
+    /// τ_in at t0 [N m].
+    pub tau0: f64,
+    /// dτ_in/dt [N m/s].
+    pub rate: f64,
+}
+
+impl TorqueRamp {
+    #[inline]
+    pub fn at(&self, t: f64) -> f64 {
+        self.tau0 + self.rate * (t - self.t0)
     }
 }
 

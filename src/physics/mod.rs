@@ -1,6 +1,7 @@
 //! The physics of the gear pair, as restated in `shared/MODEL.md`: parameters (§4), the
 //! contact law (§2), the equation of motion written for the transmission error ξ (§1, §3)
-//! and the excitation of the main shaft (§5). Knows nothing of integrators or FMI.
+//! and the excitation of the main shaft (§5), imposed or, in torque mode, an inertia driven
+//! by a torque (motion.rs). Knows nothing of integrators or FMI.
 
 pub mod contact;
 pub mod excitation;
@@ -8,6 +9,6 @@ pub mod motion;
 pub mod params;
 
 pub use contact::{ContactLaw, ForceSlopes, Region};
-pub use excitation::{Excitation, Polynomial, Shaft, Sine};
-pub use motion::{Dynamics, Loads};
+pub use excitation::{Excitation, Polynomial, Shaft, Sine, TorqueRamp};
+pub use motion::{Dynamics, Loads, MainShaft};
 pub use params::{GearParams, ParamError};

@@ -4,6 +4,9 @@
 //!   ω_L = (ξ' + r_M ω_M) / r_L
 //!   I_L ω_L' = B − r_L F − C (ω_L − ω_S)
 //!   ξ'' = r_L ω_L' − r_M a_M
+//!
+//! The main shaft's motion θ_M, ω_M, a_M is imposed (MODEL.md §5) or, in torque mode, follows
+//! from its own equation of motion ([`MainShaft`]).
 #![allow(non_snake_case)]
 
 use serde::{Deserialize, Serialize};
@@ -21,6 +24,34 @@ pub struct Loads {
     pub alpha_L: f64,
     /// ξ'' [m/s²].
     pub xi_ddot: f64,
+}
+
+/// Torque mode: the main shaft as a rigid inertia I_M, driven by the drivetrain's torque τ_in
+/// and by the contact. MODEL.md imposes the shaft; this completes its §3 with the reaction
+/// it states there, τ_M = + r_M F being the torque the contact exerts on the main shaft:
+///
+///   I_M ω_M' = τ_in + r_M F
+///   θ_M'     = ω_M
+///
+/// so that ξ'' = r_L ω_L' − r_M ω_M' couples both equations through F. Energy: with
+/// V(ξ) = ∫ F_k dξ, dV/dt = F_k ξ' = F_k (r_L ω_L − r_M ω_M), and the contact's power on the
+/// two gears, −r_L F ω_L + r_M F ω_M, cancels it when F = F_k; hence with B = C = C_LM = 0
+///
+///   ½ I_L ω_L² + ½ I_M ω_M² + V(ξ) − ∫ τ_in ω_M dt   is constant
+///
+/// (tests/energy.rs checks it).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct MainShaft {
+    /// Moment of inertia of the main shaft [kg m²].
+    pub I_M: f64,
+}
+
+impl MainShaft {
+    /// ω_M' = (τ_in + r_M F) / I_M for the drivetrain's torque τ_in and the contact force F.
+    #[inline]
+    pub fn alpha(&self, r_M: f64, tau_in: f64, force: f64) -> f64 {
+        (tau_in + r_M * force) / self.I_M
+    }
 }
 
 /// The gear pair's dynamics for one set of parameters.
@@ -41,8 +72,38 @@ impl Dynamics {
     /// Loads at (ξ, ξ') with the contact formula of `region` and the main shaft at `shaft`.
     #[inline]
     pub fn loads(&self, region: Region, xi: f64, xi_dot: f64, shaft: &Shaft) -> Loads {
-        let p = &self.params;
         let force = self.law.force(region, xi, xi_dot);
+        self.respond(force, xi_dot, shaft)
+    }
+
+    /// Torque mode: loads at (ξ, ξ') with the main shaft at angle θ_M and speed ω_M, its
+    /// acceleration following from τ_in and the contact ([`MainShaft`]); also returns the
+    /// shaft's motion with that acceleration.
+    #[inline]
+    #[allow(clippy::too_many_arguments)]
+    pub fn driven_loads(
+        &self,
+        region: Region,
+        xi: f64,
+        xi_dot: f64,
+        main: &MainShaft,
+        theta_M: f64,
+        omega_M: f64,
+        tau_in: f64,
+    ) -> (Loads, Shaft) {
+        let force = self.law.force(region, xi, xi_dot);
+        let shaft = Shaft {
+            theta: theta_M,
+            omega: omega_M,
+            alpha: main.alpha(self.params.r_M, tau_in, force.total()),
+        };
+        (self.respond(force, xi_dot, &shaft), shaft)
+    }
+
+    /// The loose gear's response to the contact force and the shaft's motion (MODEL.md §3).
+    #[inline]
+    fn respond(&self, force: ContactForce, xi_dot: f64, shaft: &Shaft) -> Loads {
+        let p = &self.params;
         let omega_L = (xi_dot + p.r_M * shaft.omega) / p.r_L;
         let alpha_L = (p.B - p.r_L * force.total() - p.C * (omega_L - p.omega_S)) / p.I_L;
         Loads {

@@ -64,6 +64,7 @@ DEFAULTS = dict(
     omega_mean=0.0,
     gap_start=0.5,
     xi_dot_start=0.0,
+    I_M=0.008,  # torque mode only: the main shaft's inertia
 )
 
 # Bench scenes (MODEL.md §5).
@@ -165,23 +166,15 @@ def _regions(p: dict):
     return [(0, -inf, 0.0), (2, 0.0, G), (4, G, inf)]
 
 
-def _make_rhs(p: dict, code: int, shaft=None):
-    """Right-hand side with the contact formula of region `code` locked.
-
-    shaft: None for the sine excitation of MODEL.md §5, else a function t -> (omega_M, a_M)."""
-    I_L, r_L, r_M = p["I_L"], p["r_L"], p["r_M"]
+def _contact(p: dict, code: int):
+    """Contact law of region `code` (MODEL.md §2) as a function (xi, xi_dot) -> (s, F)."""
     K, am1, eps, G = p["K_star"], p["alpha"] - 1.0, p["epsilon"], p["G"]
-    C_LM, C, B, om_s = p["C_LM"], p["C"], p["B"], p["omega_S"]
-    w = _TWO_PI * p["f_exc"]
-    amp = math.sqrt(2.0) * p["A_rms"]
-    amp_w = amp / w
-    om_mean = p["omega_mean"]
+    C_LM = p["C_LM"]
     inv_G = 1.0 / G
     pi_eps = math.pi / eps if eps > 0.0 else 0.0
     half_eps = 0.5 * eps
-    sin, cos, fabs, pow_ = math.sin, math.cos, math.fabs, math.pow
+    sin, fabs, pow_ = math.sin, math.fabs, math.pow
 
-    # contact: returns (s, F)
     if code == 2:
 
         def contact(xi, v):
@@ -213,6 +206,22 @@ def _make_rhs(p: dict, code: int, shaft=None):
 
     else:  # pragma: no cover
         raise ValueError(code)
+
+    return contact
+
+
+def _make_rhs(p: dict, code: int, shaft=None):
+    """Right-hand side with the contact formula of region `code` locked.
+
+    shaft: None for the sine excitation of MODEL.md §5, else a function t -> (omega_M, a_M)."""
+    I_L, r_L, r_M = p["I_L"], p["r_L"], p["r_M"]
+    C_LM, C, B, om_s = p["C_LM"], p["C"], p["B"], p["omega_S"]
+    w = _TWO_PI * p["f_exc"]
+    amp = math.sqrt(2.0) * p["A_rms"]
+    amp_w = amp / w
+    om_mean = p["omega_mean"]
+    sin, cos = math.sin, math.cos
+    contact = _contact(p, code)
 
     def rhs(t, y):
         xi = y[0]
@@ -289,25 +298,49 @@ def simulate(
     """
     p = params() if p is None else dict(p)
     G = p["G"]
-    solver_cls = _SOLVERS[method]
     atol = rtol * np.array([G, G * 3600.0, e_scale, e_scale])
+    rhs_cache = {}
+
+    def rhs_for(code, _t):
+        if code not in rhs_cache:
+            rhs_cache[code] = _make_rhs(p, code, shaft)
+        return rhs_cache[code]
+
+    y0 = np.array([p["gap_start"] * G, p["xi_dot_start"], 0.0, 0.0])
+    run = _piecewise(p, rhs_for, y0, atol, t_start, t_end, t_eval, method, rtol)
+    out = run.pop("out")
+    return Result(params=p, method=method, rtol=rtol, **_named(out), **run)
+
+
+def _named(out):
+    """The rows of `_piecewise`'s out shared by both modes, by name."""
+    return dict(xi=out[0], xi_dot=out[1], E_contact=out[2], E_lubricant=out[3])
+
+
+def _piecewise(p, rhs_for, y0, atol, t_start, t_end, t_eval, method, rtol, breaks=()):
+    """The piecewise integration of the module docstring, for any state whose first two
+    components are xi and xi_dot: rhs_for(code, t) gives the right-hand side of region `code`
+    for a piece that starts at t. A piece also ends at each time of `breaks`, where the
+    right-hand side may jump (a torque held over a communication step). Returns the fields of
+    a result: t, out (the state at the times t_eval, one row per component), the impacts, the
+    extremes of xi, counters and final_y."""
+    solver_cls = _SOLVERS[method]
     if t_eval is None:
         t_eval = np.array([t_start, t_end])
     t_eval = np.asarray(t_eval, dtype=float)
     if t_eval.size and (t_eval[0] < t_start or t_eval[-1] > t_end * (1 + 1e-12) or np.any(np.diff(t_eval) < 0)):
         raise ValueError("t_eval must be increasing within [t_start, t_end]")
-    out = np.full((4, t_eval.size), np.nan)
+    breaks = np.asarray(breaks, dtype=float)
+    y = np.array(y0, dtype=float)
+    out = np.full((y.size, t_eval.size), np.nan)
     k_out = 0  # next output index
 
     regions = _regions(p)
-    rhs_cache = {}
 
-    # initial state and region
-    xi0 = p["gap_start"] * G
-    y = np.array([xi0, p["xi_dot_start"], 0.0, 0.0])
+    # initial region
+    xi0 = y[0]
     idx = next(i for i, (_, lo, hi) in enumerate(regions) if lo <= xi0 <= hi)
     t = t_start
-
     # outputs at t_start
     while k_out < t_eval.size and t_eval[k_out] <= t_start:
         out[:, k_out] = y
@@ -318,14 +351,14 @@ def simulate(
     nfev = nsteps = npieces = 0
     stalls = 0
     xtol = 1e-16
+    piece_min = piece_max = xi0  # extremes of xi in the current region (across breaks)
 
     while t < t_end:
         code, lo, hi = regions[idx]
-        rhs = rhs_cache.get(code)
-        if rhs is None:
-            rhs = rhs_cache[code] = _make_rhs(p, code, shaft)
-        solver = solver_cls(rhs, t, y, t_end, rtol=rtol, atol=atol)
-        piece_min = piece_max = y[0]  # extremes of xi over this piece
+        rhs = rhs_for(code, t)
+        later = breaks[breaks > t * (1.0 + 1e-14) + 1e-300]
+        t_stop = min(t_end, later[0]) if later.size else t_end
+        solver = solver_cls(rhs, t, y, t_stop, rtol=rtol, atol=atol)
         npieces += 1
         crossing = None  # (t_event, y_event, +1 upper / -1 lower)
         while True:
@@ -388,7 +421,9 @@ def simulate(
         nfev += solver.nfev
         if crossing is None:
             t, y = solver.t, solver.y
-            break
+            if t >= t_end:
+                break
+            continue  # a break: the same region goes on with the next right-hand side
         t_c, y, side = crossing
         stalls = stalls + 1 if t_c <= t else 0
         if stalls > 20:
@@ -402,19 +437,16 @@ def simulate(
             # depth of the excursion into the gap since the last flank: G after a crossing
             imp_x.append(piece_max - lo if side < 0 else hi - piece_min)
         idx = new_idx
+        piece_min = piece_max = y[0]
 
     # outputs exactly at t_end that may remain (t_eval[-1] == t_end rounding)
     while k_out < t_eval.size:
         out[:, k_out] = y
         k_out += 1
 
-    return Result(
-        params=p,
+    return dict(
         t=t_eval,
-        xi=out[0],
-        xi_dot=out[1],
-        E_contact=out[2],
-        E_lubricant=out[3],
+        out=out,
         impact_t=np.array(imp_t),
         impact_flank=np.array(imp_fl, dtype=int),
         impact_speed=np.array(imp_v),
@@ -424,9 +456,117 @@ def simulate(
         nfev=nfev,
         nsteps=nsteps,
         npieces=npieces,
-        method=method,
-        rtol=rtol,
         final_y=np.array(y),
+    )
+
+
+# ----------------------------------------------------------------------------------------
+# Torque mode (the FMU's excitation = 2)
+# ----------------------------------------------------------------------------------------
+#
+# MODEL.md imposes the main shaft; its §3 gives the torque the contact exerts on it,
+# tau_M = + r_M F. In torque mode the shaft is a rigid inertia I_M driven by the drivetrain's
+# torque tau_in and by that reaction:
+#
+#     I_M omega_M' = tau_in + r_M F,   theta_M' = omega_M,   xi'' = r_L omega_L' - r_M omega_M'
+#
+# State [xi, xi_dot, E_contact, E_lubricant, theta_M, omega_M], the same piecewise driver.
+
+
+def _make_rhs_torque(p: dict, code: int, tau):
+    """Right-hand side of the torque mode with region `code` locked; tau: t -> tau_in."""
+    I_L, I_M, r_L, r_M = p["I_L"], p["I_M"], p["r_L"], p["r_M"]
+    C_LM, C, B, om_s = p["C_LM"], p["C"], p["B"], p["omega_S"]
+    contact = _contact(p, code)
+
+    def rhs(t, y):
+        xi, v, om_m = y[0], y[1], y[5]
+        s, f = contact(xi, v)
+        om_rel = (v + r_M * om_m) / r_L - om_s
+        dom_l = (B - r_L * f - C * om_rel) / I_L
+        a_m = (tau(t) + r_M * f) / I_M
+        return np.array((v, r_L * dom_l - r_M * a_m, s * C_LM * v * v, C * om_rel * om_rel, om_m, a_m))
+
+    return rhs
+
+
+@dataclass
+class TorqueResult(Result):
+    """What `simulate_torque` returns: a Result plus the main shaft's motion."""
+
+    theta_M: np.ndarray = None
+    omega_M: np.ndarray = None
+    alpha_M: np.ndarray = None  # (tau_in + r_M F) / I_M at the output points
+
+    def loose_gear(self):
+        """omega_L, alpha_L, F at the output points."""
+        p = self.params
+        om_l = (self.xi_dot + p["r_M"] * self.omega_M) / p["r_L"]
+        f = contact_force(self.xi, self.xi_dot, p)
+        al_l = (p["B"] - p["r_L"] * f - p["C"] * (om_l - p["omega_S"])) / p["I_L"]
+        return om_l, al_l, f
+
+
+def held_torque(t_k, tau_k, rate_k=None):
+    """The torque a master gives at communication points t_k: tau_k, and with input
+    derivatives rate_k, ramped as tau_k + rate_k (t - t_k) until t_(k+1).
+    Returns (segment(t0) -> the function tau(t) of the segment that starts at t0, breaks)."""
+    t_k = np.asarray(t_k, dtype=float)
+    tau_k = np.asarray(tau_k, dtype=float)
+    rate_k = np.zeros_like(tau_k) if rate_k is None else np.asarray(rate_k, dtype=float)
+
+    def segment(t0):
+        k = max(int(np.searchsorted(t_k, t0 * (1.0 + 1e-14) + 1e-300, side="right")) - 1, 0)
+        t_s, a, b = float(t_k[k]), float(tau_k[k]), float(rate_k[k])
+        return lambda t: a + b * (t - t_s)
+
+    return segment, t_k[1:]
+
+
+def simulate_torque(
+    p: dict | None = None,
+    t_end: float = 0.05,
+    tau=None,
+    held=None,
+    theta_M0: float = 0.0,
+    omega_M0: float = 0.0,
+    t_eval=None,
+    method: str = "DOP853",
+    rtol: float = 1e-12,
+    e_scale: float = 1e-3,
+) -> TorqueResult:
+    """Integrate the torque mode from t = 0: xi(0) = gap_start G, xi_dot(0) = xi_dot_start,
+    theta_M(0) = theta_M0, omega_M(0) = omega_M0, the shaft's inertia p["I_M"].
+
+    tau: a smooth torque t -> tau_in; or held: the output of `held_torque` (what a master
+    sets at each communication point), whose segments end pieces of the integration.
+    The absolute tolerances are those of `simulate`, and for theta_M, omega_M the ones of
+    xi, xi_dot divided by r_M."""
+    p = params() if p is None else dict(p)
+    G, r_M = p["G"], p["r_M"]
+    atol = rtol * np.array([G, G * 3600.0, e_scale, e_scale, G / r_M, G * 3600.0 / r_M])
+    if held is not None:
+        segment, breaks = held
+    elif tau is not None:
+        segment, breaks = (lambda _t0: tau), ()
+    else:
+        segment, breaks = (lambda _t0: (lambda _t: 0.0)), ()
+
+    def rhs_for(code, t0):
+        return _make_rhs_torque(p, code, segment(t0))
+
+    y0 = np.array([p["gap_start"] * G, p["xi_dot_start"], 0.0, 0.0, theta_M0, omega_M0])
+    run = _piecewise(p, rhs_for, y0, atol, 0.0, t_end, t_eval, method, rtol, breaks)
+    out = run.pop("out")
+    # the shaft's acceleration at the output points, from the torque of the segment that
+    # holds each point (the one that ends there, at a break) and the contact force
+    seg_t = np.concatenate(([0.0], np.asarray(breaks, dtype=float)))
+    tau_out = np.array(
+        [segment(seg_t[max(int(np.searchsorted(seg_t, t, side="left")) - 1, 0)])(t) for t in run["t"]]
+    )
+    alpha = (tau_out + r_M * contact_force(out[0], out[1], p)) / p["I_M"]
+    return TorqueResult(
+        params=p, method=method, rtol=rtol, theta_M=out[4], omega_M=out[5], alpha_M=alpha, **_named(out), **run
     )
 
 

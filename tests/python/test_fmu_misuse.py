@@ -329,7 +329,7 @@ def test_invalid_parameter_refused(slave, name, value):
 @pytest.mark.parametrize(
     "integers,reals,named",
     [
-        ({"excitation": 2}, {}, "excitation"),
+        ({"excitation": 3}, {}, "excitation"),
         ({"excitation": -1}, {}, "excitation"),
         ({"excitation": 1}, {"f_exc": 0.0}, "f_exc"),
         ({"solver": 3}, {}, "solver"),
