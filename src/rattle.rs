@@ -159,28 +159,38 @@ impl Jacobian<N> for Rattle {
     }
 }
 
-impl Piecewise<N> for Rattle {
-    const GUARD: usize = XI;
-    const RATE: usize = XI_DOT;
+/// `Piecewise` for a gear pair with fields `dynamics`, `region` and `impacts`, and ξ, ξ' at the
+/// components `XI`, `XI_DOT` of its `N`-state (names resolved where it is used): the pieces
+/// are the contact law's regions, and crossing out of the gap counts an impact.
+macro_rules! contact_pieces {
+    ($gear:ty) => {
+        impl $crate::integrator::Piecewise<N> for $gear {
+            const GUARD: usize = XI;
+            const RATE: usize = XI_DOT;
 
-    fn piece(&self) -> (f64, f64) {
-        self.dynamics.law.bounds(self.region)
-    }
+            fn piece(&self) -> (f64, f64) {
+                self.dynamics.law.bounds(self.region)
+            }
 
-    fn rough_start(&self) -> bool {
-        self.dynamics.law.rough_at_onset(self.region)
-    }
+            fn rough_start(&self) -> bool {
+                self.dynamics.law.rough_at_onset(self.region)
+            }
 
-    fn cross(&mut self, edge: Edge, _t: f64, y: &State) {
-        self.region = cross_edge(
-            &self.dynamics,
-            self.region,
-            &mut self.impacts,
-            edge,
-            y[XI_DOT],
-        );
-    }
+            fn cross(&mut self, edge: $crate::integrator::Edge, _t: f64, y: &[f64; N]) {
+                self.region = $crate::rattle::cross_edge(
+                    &self.dynamics,
+                    self.region,
+                    &mut self.impacts,
+                    edge,
+                    y[XI_DOT],
+                );
+            }
+        }
+    };
 }
+pub(crate) use contact_pieces;
+
+contact_pieces!(Rattle);
 
 #[cfg(test)]
 mod tests {

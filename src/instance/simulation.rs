@@ -66,7 +66,10 @@ impl<S: GearPair<N> + Jacobian<N>, const N: usize> Stepped<S, N> {
     }
 }
 
-/// The gear pair in one of the two couplings.
+/// The gear pair in one of the two couplings. Plain data kept in place (it is copied whole
+/// for a rollback and serialized for the FMU state), so the torque variant's two more states
+/// are not boxed.
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub enum Gear {
     /// The main shaft's motion imposed (sine or inputs): state ξ, ξ' and the quadratures.

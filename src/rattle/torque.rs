@@ -15,9 +15,9 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::{GearPair, Impacts, cross_edge, scales};
+use super::{GearPair, Impacts, contact_pieces, scales};
 pub use super::{XI, XI_DOT};
-use crate::integrator::{Edge, Jacobian, Piecewise, System, Tolerance};
+use crate::integrator::{Jacobian, System, Tolerance};
 use crate::physics::{Dynamics, Loads, MainShaft, Region, Shaft, TorqueRamp};
 
 /// Components of the state vector after ξ, ξ' (the quadratures' meanings as in
@@ -162,24 +162,7 @@ impl Jacobian<N> for TorqueRattle {
     }
 }
 
-impl Piecewise<N> for TorqueRattle {
-    const GUARD: usize = XI;
-    const RATE: usize = XI_DOT;
-
-    fn piece(&self) -> (f64, f64) {
-        self.dynamics.law.bounds(self.region)
-    }
-
-    fn cross(&mut self, edge: Edge, _t: f64, y: &State) {
-        self.region = cross_edge(
-            &self.dynamics,
-            self.region,
-            &mut self.impacts,
-            edge,
-            y[XI_DOT],
-        );
-    }
-}
+contact_pieces!(TorqueRattle);
 
 #[cfg(test)]
 mod tests {
