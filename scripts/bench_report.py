@@ -341,12 +341,11 @@ def analysis(rows, s1, r_rust, n_rust, r_user, n_user, r_py, n_py, comm_rows, to
         rtol, cf, cs, rh, er = key[0]
         a(f"**Communication steps** (rtol {rtol:g}): {rh[1e-2]:.3g} RHS for 1 s at 10 ms, {rh[1e-3]:.3g} at 1 ms, "
           f"{rh[1e-4]:.3g} at 0.1 ms, {rh[1e-5]:.3g} at 10 µs; CPU at 10 µs is {cf[1e-5] / cf[1e-2]:.1f}× that at 10 ms. "
-          "The solver state and step size do carry over between DoSteps, but every DoStep ends exactly on its "
-          "communication point, so below the natural step size (tens of µs in contact, longer in free flight) each "
-          "communication step costs at least one full step (6 RHS). The lever: in sine mode, and in inputs mode "
-          "whenever the inputs are the extrapolation the FMU already uses, integrate past the communication point "
-          "with the natural step and serve the outputs from the dense output (DOPRI5's, already computed for edge "
-          "location), cutting a step only at edges and when new inputs arrive. "
+          "In sine mode the FMU serves communication points from the dense output of its natural DOPRI5 steps "
+          "and resumes from their ends (Solver::interpolate_ends), so the steps, and the RHS count, are those of "
+          "a run without communication points; what is left at 10 µs is the cost of each DoStep call itself "
+          "(argument checks, the state copy kept for a failed step, the interpolation, the outputs read). "
+          "In inputs mode new inputs arrive at every DoStep and steps still end on the communication points. "
           f"FMI overhead at 0.1 ms: {(cf[1e-4] / cs[1e-4] - 1) * 100:+.0f} % (C API against Simulation::step_to; "
           "the same copies and checks are in both, the difference is the C boundary, argument checks and the "
           "fmi crate's wrappers).")
@@ -565,8 +564,8 @@ def main() -> None:
     w("- Cost: CPU time of the calling thread (Rust: CLOCK_THREAD_CPUTIME_ID; Python: process_time), median of "
       "interleaved repeats (Rust: 3-9 within a 1.5 s budget per group; Python: 3 when a run is under 2 s, else 1); "
       "RHS evaluations as counted in the RHS itself (peers) or by the integrator (GearRattle).")
-    w("- GearRattle (direct): `Rattle` + `Solver::advance` to each 1 ms grid point (it has no public dense output, "
-      "so it stops there). Simulation::step_to: the FMU's simulation object stepped at the communication step "
+    w("- GearRattle (direct): `Rattle` + `Solver::advance` to each 1 ms grid point, served from the dense output "
+      "of its natural steps (`interpolate_ends`, as the FMU in sine mode). Simulation::step_to: the FMU's simulation object stepped at the communication step "
       "without FMI, outputs read after each step; the FMI overhead is the FMU through the C API "
       "(`fmi` crate 0.8: fmi2DoStep + fmi2GetReal of ξ, ξ' each step) against it.")
     w("- Rust crates: the same RHS function (`Rattle`'s, so one evaluation costs the same everywhere and the "
