@@ -15,7 +15,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::{GearPair, Impacts, contact_pieces, scales};
+use super::{GearPair, Impacts, LOCAL_SHARE, contact_pieces, scales};
 pub use super::{XI, XI_DOT};
 use crate::integrator::{Jacobian, System, Tolerance};
 use crate::physics::{Dynamics, Loads, MainShaft, Region, Shaft, TorqueRamp};
@@ -56,6 +56,7 @@ impl TorqueRattle {
     /// ω_M on the same scales seen on the pitch line (divided by r_M), so that the shaft's
     /// error moves ξ no more than the gear's own.
     pub fn tolerance(&self, rtol: f64) -> Tolerance<N> {
+        let rtol = rtol * LOCAL_SHARE;
         let (xi_scale, xi_dot_scale) = scales(&self.dynamics.params);
         let r_M = self.dynamics.params.r_M;
         Tolerance {
