@@ -125,6 +125,41 @@ fn interpolated_ends_cost_nothing_and_keep_the_accuracy() {
     assert!(e_many < 1e-6 && e1 < 1e-6, "{e_many:e} {e1:e}");
 }
 
+/// A master that passes its own time k·h rather than the one it was handed back,
+/// (k − 1)·h + h, which differs by an ulp or so: its points are still served from the kept
+/// steps, at the cost of one call.
+#[test]
+fn interpolated_ends_survive_times_rounded_differently() {
+    let tol = Tolerance {
+        rtol: 1e-8,
+        atol: [1e-8],
+        controlled: 1,
+    };
+    let mut solver = Solver::new(tol);
+    solver.interpolate_ends = true;
+    let (mut t, mut y) = (0.0, [1.0]);
+    let h = 1e-3;
+    let mut rounded_differently = 0;
+    for k in 0..20_000 {
+        let master_t = k as f64 * h;
+        if master_t != t {
+            rounded_differently += 1;
+        }
+        t = master_t;
+        solver
+            .advance(&mut Exp, &mut t, &mut y, master_t + h)
+            .unwrap();
+    }
+    let (_, one_call) = adaptive(1e-8, 1, true);
+    println!(
+        "{rounded_differently} of 20 000 times rounded differently; {} rhs against {one_call}",
+        solver.stats.rhs_evals
+    );
+    assert!(rounded_differently > 1000);
+    assert!(solver.stats.rhs_evals <= one_call + 30);
+    assert!((y[0] - exact(20.0)).abs() < 1e-6);
+}
+
 /// x'' = a_above while x ≥ 0 and a_below while x ≤ 0: piecewise quadratic exact solutions,
 /// with the crossings of x = 0 recorded.
 struct TwoPieces {

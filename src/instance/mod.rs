@@ -446,7 +446,7 @@ impl Instance {
         }
         sim.t = current;
         let t_end = current + h;
-        let before = *sim;
+        let (impacts_before, switches_before) = (sim.impacts(), sim.stats().switches);
         match sim.step_to(t_end) {
             Ok(()) => {
                 self.last_successful_time = t_end;
@@ -459,8 +459,8 @@ impl Instance {
                     "DOPRI5"
                 };
                 let new = [
-                    impacts.count[0] - before.impacts().count[0],
-                    impacts.count[1] - before.impacts().count[1],
+                    impacts.count[0] - impacts_before.count[0],
+                    impacts.count[1] - impacts_before.count[1],
                 ];
                 if new != [0, 0] {
                     self.log(Status::Ok, EVENTS, || {
@@ -470,7 +470,7 @@ impl Instance {
                         )
                     });
                 }
-                if stats.switches != before.stats().switches {
+                if stats.switches != switches_before {
                     self.log(Status::Ok, EVENTS, || {
                         format!("t = {t_end}: integration method handed over, now {method}")
                     });

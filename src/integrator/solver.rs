@@ -125,6 +125,13 @@ struct Ahead<const N: usize> {
 }
 
 impl<const N: usize> Ahead<N> {
+    /// Whether a call from (t, y) continues from where the last one left off. The time may
+    /// come back rounded differently (a master passing k·h where t_end was (k−1)·h + h): a
+    /// few ulps are the same point; the state must be the same bits.
+    fn continued_by(&self, t: f64, y: &[f64; N]) -> bool {
+        (t - self.t_out).abs() <= 4.0 * f64::EPSILON * self.t_out.abs() && *y == self.y_out
+    }
+
     /// (t, y) at t_end inside the step, handed out and remembered.
     fn serve(&mut self, t: &mut f64, y: &mut [f64; N], t_end: f64) {
         let theta = (t_end - self.t0) / self.step.h;
@@ -224,6 +231,12 @@ impl<const N: usize> Solver<N> {
         self.stepper.invalidate();
     }
 
+    /// Whether `advance` from (t, y) to t_end will be served from the step kept from the
+    /// last call alone (no stepping, so it cannot fail).
+    pub fn serves(&self, t: f64, y: &[f64; N], t_end: f64) -> bool {
+        matches!(&self.ahead, Some(a) if a.continued_by(t, y) && t_end <= a.t0 + a.step.h)
+    }
+
     /// Step size the next step will try.
     pub fn proposed_step(&self) -> f64 {
         self.h
@@ -247,7 +260,7 @@ impl<const N: usize> Solver<N> {
         t_end: f64,
     ) -> Result<(), SolverError> {
         if let Some(mut ahead) = self.ahead.take() {
-            if *t != ahead.t_out || *y != ahead.y_out {
+            if !ahead.continued_by(*t, y) {
                 // Not where the last call left off: k1 was f at the step's end.
                 self.k1_valid = false;
             } else if t_end <= ahead.t0 + ahead.step.h {
