@@ -185,9 +185,11 @@ def main() -> int:
       "at what time, fmi2GetReal still giving the last good state.")
     w("")
     w("Any case may also pass by refusing cleanly in that way, except S1 and the hour. The windows "
-      "are short (12 ms: S1's first two impacts) because the tolerance bounds the error per step: "
-      "on S1 the error grows by 2-5 rtol per impact while the model itself does not amplify it "
-      "(a change of ξ(0) comes out ×1.5 after 50 ms), so 10 × rtol is a claim about a few impacts.")
+      "are short (12 ms: S1's first two impacts) because the integrator bounds the error per step "
+      "(a quarter of rtol each, `LOCAL_SHARE` in src/rattle.rs) and those errors add up: with the "
+      "whole rtol per step, S1's error grew by 2-5 rtol per impact, while the model itself does not "
+      "amplify it (a change of ξ(0) comes out ×1.5 after 50 ms); so 10 × rtol is a claim about a "
+      "few impacts.")
     w("")
     w("CPU is the process time inside fmi2DoStep (median of repeats for runs under "
       f"{MIN_CPU:g} s); **CPU ratio** = (CPU per simulated second) / (S1's CPU per simulated second), "
