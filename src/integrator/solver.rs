@@ -125,6 +125,11 @@ struct Ahead<const N: usize> {
 }
 
 impl<const N: usize> Ahead<N> {
+    /// Where the kept step ends.
+    fn t1(&self) -> f64 {
+        self.t0 + self.step.h
+    }
+
     /// Whether a call from (t, y) continues from where the last one left off. The time may
     /// come back rounded differently (a master passing k·h where t_end was (k−1)·h + h): a
     /// few ulps are the same point; the state must be the same bits.
@@ -234,7 +239,7 @@ impl<const N: usize> Solver<N> {
     /// Whether `advance` from (t, y) to t_end will be served from the step kept from the
     /// last call alone (no stepping, so it cannot fail).
     pub fn serves(&self, t: f64, y: &[f64; N], t_end: f64) -> bool {
-        matches!(&self.ahead, Some(a) if a.continued_by(t, y) && t_end <= a.t0 + a.step.h)
+        matches!(&self.ahead, Some(a) if a.continued_by(t, y) && t_end <= a.t1())
     }
 
     /// Step size the next step will try.
@@ -263,12 +268,12 @@ impl<const N: usize> Solver<N> {
             if !ahead.continued_by(*t, y) {
                 // Not where the last call left off: k1 was f at the step's end.
                 self.k1_valid = false;
-            } else if t_end <= ahead.t0 + ahead.step.h {
+            } else if t_end <= ahead.t1() {
                 ahead.serve(t, y, t_end);
                 self.ahead = Some(ahead);
                 return Ok(());
             } else {
-                *t = ahead.t0 + ahead.step.h;
+                *t = ahead.t1();
                 *y = ahead.step.y1;
                 if let Some(edge) = ahead.edge {
                     self.cross(sys, edge, *t, y);
@@ -318,8 +323,7 @@ impl<const N: usize> Solver<N> {
             {
                 // The edge lies past t_end: the step redone to end on it is kept ahead, t_end
                 // served from it, and the edge crossed when a call goes past it.
-                let trial = dopri5::step(sys, *t, y, &k1, theta * h);
-                self.stats.rhs_evals += EVALS_PER_STEP;
+                let trial = self.explicit_step(sys, start, theta * h);
                 self.h = step.h_next.max(theta * h);
                 self.keep_ahead(trial, Some(edge), t, y, t_end);
                 return Ok(());
@@ -429,8 +433,7 @@ impl<const N: usize> Solver<N> {
                 h_rho: 0.0,
             })
         } else {
-            let trial = dopri5::step(sys, at.t, at.y, at.k1, h);
-            self.stats.rhs_evals += EVALS_PER_STEP;
+            let trial = self.explicit_step(sys, at, h);
             let mut err = self.tol.norm(&trial.y0, &trial.y1, &trial.err);
             if self.just_crossed && sys.rough_start() {
                 err *= FIRST_STEP_DISTRUST;
@@ -465,9 +468,19 @@ impl<const N: usize> Solver<N> {
             let trial = self.implicit_step(sys, at, h);
             trial.converged().then_some(trial.y1)
         } else {
-            self.stats.rhs_evals += EVALS_PER_STEP;
-            Some(dopri5::step(sys, at.t, at.y, at.k1, h).y1)
+            Some(self.explicit_step(sys, at, h).y1)
         }
+    }
+
+    /// A DOPRI5 trial, with its work counted.
+    fn explicit_step<S: Piecewise<N>>(
+        &mut self,
+        sys: &S,
+        at: Start<N>,
+        h: f64,
+    ) -> dopri5::Trial<N> {
+        self.stats.rhs_evals += EVALS_PER_STEP;
+        dopri5::step(sys, at.t, at.y, at.k1, h)
     }
 
     /// A Radau IIA trial, with its work counted and the spectral radius of a new Jacobian
