@@ -333,7 +333,11 @@ fn rust(c: &Contract, guid: &str) -> String {
         )
         .unwrap();
     }
-    r += "];\n";
+    r += "];\n\n/// Index in VARIABLES of the variable of a kind and value reference (a jump table, not\n/// a search: fmi2GetReal looks every reference up).\npub fn index(kind: Kind, vr: u32) -> Option<usize> {\n    match (kind, vr) {\n";
+    for (i, v) in c.variable.iter().enumerate() {
+        writeln!(r, "        (Kind::{}, {}) => Some({i}),", v.ty, v.vr).unwrap();
+    }
+    r += "        _ => None,\n    }\n}\n";
     r
 }
 

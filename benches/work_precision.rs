@@ -663,6 +663,11 @@ fn main() {
     let fmu_path = std::env::var("BENCH_FMU")
         .map(PathBuf::from)
         .unwrap_or_else(|_| root.join("target/fmu/GearRattle.fmu"));
+    if std::env::var("BENCH_PROFILE").is_ok_and(|v| v == "calls") {
+        let import: Fmi2Import = fmi::import::from_path(&fmu_path).expect("the FMU (make fmu)");
+        profile::calls(&load_scenes(&ref_dir), &import);
+        return;
+    }
     let out_path = std::env::var("BENCH_OUT")
         .map(PathBuf::from)
         .unwrap_or_else(|_| root.join("target/bench/rust.csv"));

@@ -48,5 +48,5 @@ pub const MODEL_DESCRIPTION_XML: &str =
 
 /// Looks a variable up by kind and value reference.
 pub fn find(kind: Kind, vr: u32) -> Option<&'static Variable> {
-    VARIABLES.iter().find(|v| v.kind == kind && v.vr == vr)
+    index(kind, vr).map(|i| &VARIABLES[i])
 }

@@ -176,3 +176,48 @@ pub fn run(scenes: &[Scene]) {
         (per_run - rhs_time) / run.rhs as f64 * 1e9
     );
 }
+
+/// `BENCH_PROFILE=calls`: the cost of each communication step on S1 (1 s) at
+/// BENCH_PROFILE_RTOL (default 1e-7): GearRattle alone (1 ms grid), `Simulation::step_to`
+/// and the C API at 10 ms and 10 µs, interleaved for BENCH_PROFILE_SECONDS (default 4) of
+/// CPU; BENCH_PROFILE_ONLY=fmu|steps runs only that one at 10 µs (for `perf record`).
+pub fn calls(scenes: &[Scene], import: &Fmi2Import) {
+    let sc = scenes
+        .iter()
+        .find(|s| s.name == "S1-1s")
+        .expect("scene S1-1s in the reference");
+    let env = |k: &str, d: f64| {
+        std::env::var(k)
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(d)
+    };
+    let rtol = env("BENCH_PROFILE_RTOL", 1e-7);
+    let seconds = env("BENCH_PROFILE_SECONDS", 4.0);
+    let only = std::env::var("BENCH_PROFILE_ONLY").ok();
+    type Runner<'a> = Box<dyn Fn() -> Outcome + 'a>;
+    let mut runs: Vec<(&str, Runner)> = vec![
+        ("direct, 1 ms grid", Box::new(|| run_gearrattle(sc, rtol))),
+        ("step_to 10 ms", Box::new(|| run_steps(sc, rtol, 1e-2))),
+        ("step_to 10 us", Box::new(|| run_steps(sc, rtol, 1e-5))),
+        ("C API 10 ms", Box::new(|| run_fmu(import, sc, rtol, 1e-2))),
+        ("C API 10 us", Box::new(|| run_fmu(import, sc, rtol, 1e-5))),
+    ];
+    match only.as_deref() {
+        Some("fmu") => runs.retain(|(name, _)| *name == "C API 10 us"),
+        Some("steps") => runs.retain(|(name, _)| *name == "step_to 10 us"),
+        _ => {}
+    }
+    let mut cpu: Vec<Vec<f64>> = vec![Vec::new(); runs.len()];
+    let start = cpu_now();
+    while cpu_now() - start < seconds || cpu[0].is_empty() {
+        for (i, (_, run)) in runs.iter().enumerate() {
+            cpu[i].push(run().expect("run").1);
+        }
+    }
+    let med: Vec<f64> = cpu.iter().map(|c| median(c)).collect();
+    println!("S1 1 s at rtol {rtol:e}, median CPU of {} interleaved runs:", cpu[0].len());
+    for (i, (name, _)) in runs.iter().enumerate() {
+        println!("  {name:20} {:8.3} ms  ({:.2}x the first)", med[i] * 1e3, med[i] / med[0]);
+    }
+}

@@ -15,6 +15,9 @@ pub struct Component {
 
 impl Component {
     pub fn flush_log(&mut self) {
+        if self.instance.messages.is_empty() {
+            return;
+        }
         for m in self.instance.messages.drain(..) {
             self.logger.log(m.status, m.category, &m.text);
         }

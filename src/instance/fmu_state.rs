@@ -10,7 +10,7 @@ use crate::contract::GUID;
 use serde::{Deserialize, Serialize};
 
 const MAGIC: &[u8; 4] = b"GRFS";
-const VERSION: u16 = 1;
+const VERSION: u16 = 2;
 const HEADER: usize = 4 + 2 + 4;
 const TRAILER: usize = 4;
 

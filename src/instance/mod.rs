@@ -15,6 +15,7 @@ pub use state::FmiState;
 
 use crate::contract::{self, Causality, Kind, LOG_CATEGORIES, vr};
 use crate::physics::Shaft;
+use crate::rattle::Impacts;
 use serde::{Deserialize, Serialize};
 use values::Values;
 
@@ -197,16 +198,25 @@ impl Instance {
 
     pub fn get_real(&mut self, vrs: &[u32], out: &mut [f64]) -> FmiResult {
         for (vr, out) in vrs.iter().zip(out) {
-            let var = Self::variable(Kind::Real, *vr)?;
-            *out = match var.causality {
-                Causality::Output => self
-                    .current()?
-                    .real_output(*vr)
-                    .expect("every Real output of the contract is computed"),
-                _ => self.values.real(*vr),
+            // An output of the running simulation first: what a master reads after each step.
+            *out = match self.sim.as_ref().and_then(|sim| sim.real_output(*vr)) {
+                Some(value) => value,
+                None => self.real_value(*vr)?,
             };
         }
         Ok(())
+    }
+
+    /// A Real variable's value by its contract entry (a parameter, an input, or an output of
+    /// the simulation built from the values so far).
+    fn real_value(&mut self, vr: u32) -> FmiResult<f64> {
+        Ok(match Self::variable(Kind::Real, vr)?.causality {
+            Causality::Output => self
+                .current()?
+                .real_output(vr)
+                .expect("every Real output of the contract is computed"),
+            _ => self.values.real(vr),
+        })
     }
 
     pub fn get_integer(&mut self, vrs: &[u32], out: &mut [i32]) -> FmiResult {
@@ -446,48 +456,18 @@ impl Instance {
         }
         sim.t = current;
         let t_end = current + h;
-        let (impacts_before, switches_before) = (sim.impacts(), sim.stats().switches);
+        // What the event log compares with, taken only when that log is on.
+        let before = self.logging[EVENTS].then(|| (sim.impacts(), sim.stats().switches));
         match sim.step_to(t_end) {
             Ok(()) => {
                 self.last_successful_time = t_end;
                 self.sync_inputs();
-                let sim = self.sim.as_ref().expect("initialised");
-                let (stats, impacts, h_next) = (sim.stats(), sim.impacts(), sim.proposed_step());
-                let method = if sim.is_implicit() {
-                    "Radau IIA"
-                } else {
-                    "DOPRI5"
-                };
-                let new = [
-                    impacts.count[0] - impacts_before.count[0],
-                    impacts.count[1] - impacts_before.count[1],
-                ];
-                if new != [0, 0] {
-                    self.log(Status::Ok, EVENTS, || {
-                        format!(
-                            "t = {t_end}: {} impact(s) on F+, {} on F-, last at |xi'| = {:e} m/s",
-                            new[0], new[1], impacts.last_speed
-                        )
-                    });
+                if let Some(before) = before {
+                    self.log_events(t_end, before);
                 }
-                if stats.switches != switches_before {
-                    self.log(Status::Ok, EVENTS, || {
-                        format!("t = {t_end}: integration method handed over, now {method}")
-                    });
+                if self.logging[STEPS] {
+                    self.log_steps(t_end);
                 }
-                self.log(Status::Ok, STEPS, || {
-                    format!(
-                        "t = {t_end}: {} accepted ({} by Radau IIA), {} rejected steps, {} edges, {} rhs evaluations, {} Jacobians, {} LU in total; next step {:e} s by {method}",
-                        stats.accepted,
-                        stats.implicit_steps,
-                        stats.rejected,
-                        stats.edges,
-                        stats.rhs_evals,
-                        stats.jacobians,
-                        stats.decompositions,
-                        h_next
-                    )
-                });
                 Ok(())
             }
             Err(e) => {
@@ -497,6 +477,61 @@ impl Instance {
                 )))
             }
         }
+    }
+
+    fn simulation(&self) -> &Simulation {
+        self.sim.as_ref().expect("initialised")
+    }
+
+    fn method_name(sim: &Simulation) -> &'static str {
+        if sim.is_implicit() {
+            "Radau IIA"
+        } else {
+            "DOPRI5"
+        }
+    }
+
+    /// logEvents after a step: the impacts it counted and a hand-over of the method.
+    fn log_events(&mut self, t_end: f64, (impacts_before, switches_before): (Impacts, u64)) {
+        let sim = self.simulation();
+        let (impacts, switched) = (sim.impacts(), sim.stats().switches != switches_before);
+        let method = Self::method_name(sim);
+        let new = [
+            impacts.count[0] - impacts_before.count[0],
+            impacts.count[1] - impacts_before.count[1],
+        ];
+        if new != [0, 0] {
+            self.log(Status::Ok, EVENTS, || {
+                format!(
+                    "t = {t_end}: {} impact(s) on F+, {} on F-, last at |xi'| = {:e} m/s",
+                    new[0], new[1], impacts.last_speed
+                )
+            });
+        }
+        if switched {
+            self.log(Status::Ok, EVENTS, || {
+                format!("t = {t_end}: integration method handed over, now {method}")
+            });
+        }
+    }
+
+    /// logStep after a step: the solver's work so far.
+    fn log_steps(&mut self, t_end: f64) {
+        let sim = self.simulation();
+        let (stats, h_next, method) = (sim.stats(), sim.proposed_step(), Self::method_name(sim));
+        self.log(Status::Ok, STEPS, || {
+            format!(
+                "t = {t_end}: {} accepted ({} by Radau IIA), {} rejected steps, {} edges, {} rhs evaluations, {} Jacobians, {} LU in total; next step {:e} s by {method}",
+                stats.accepted,
+                stats.implicit_steps,
+                stats.rejected,
+                stats.edges,
+                stats.rhs_evals,
+                stats.jacobians,
+                stats.decompositions,
+                h_next
+            )
+        });
     }
 
     /// fmi2LastSuccessfulTime.

@@ -45,9 +45,20 @@ pub struct Stepped<S, const N: usize> {
     pub y: [f64; N],
 }
 
-impl<S: GearPair<N> + Jacobian<N>, const N: usize> Stepped<S, N> {
+impl<S: GearPair<N> + Jacobian<N> + Copy, const N: usize> Stepped<S, N> {
+    /// Advances to t_end; on failure the pair, its solver and t are left as they were. A
+    /// call served from the solver's kept step cannot fail and needs no copy to roll back to
+    /// (at 10 µs communication steps most are).
     fn advance(&mut self, t: &mut f64, t_end: f64) -> Result<(), SolverError> {
-        self.solver.advance(&mut self.system, t, &mut self.y, t_end)
+        if self.solver.serve(t, &mut self.y, t_end) {
+            return Ok(());
+        }
+        let (before, t_before) = (*self, *t);
+        let advanced = self.solver.advance(&mut self.system, t, &mut self.y, t_end);
+        if advanced.is_err() {
+            (*self, *t) = (before, t_before);
+        }
+        advanced
     }
 
     fn now(&self) -> Now<'_> {
@@ -313,20 +324,9 @@ impl Simulation {
 
     /// Advances to t_end. On failure the simulation is left as it was.
     pub fn step_to(&mut self, t_end: f64) -> Result<(), SolverError> {
-        // A step served from the solver's kept step cannot fail: no copy to roll back to (at
-        // 10 µs communication steps most are).
-        let served = match &self.gear {
-            Gear::Kinematic(k) => k.solver.serves(self.t, &k.y, t_end),
-            Gear::Torque(k) => k.solver.serves(self.t, &k.y, t_end),
-        };
-        let before = (!served).then_some(*self);
-        let advanced = match &mut self.gear {
-            Gear::Kinematic(k) => k.advance(&mut self.t, t_end),
-            Gear::Torque(k) => k.advance(&mut self.t, t_end),
-        };
-        if let (Err(e), Some(before)) = (advanced, before) {
-            *self = before;
-            return Err(e);
+        match &mut self.gear {
+            Gear::Kinematic(k) => k.advance(&mut self.t, t_end)?,
+            Gear::Torque(k) => k.advance(&mut self.t, t_end)?,
         }
         self.t = t_end;
         // The inputs continue along their extrapolation unless the master sets new ones.

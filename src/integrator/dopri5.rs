@@ -146,16 +146,51 @@ impl<const N: usize> Trial<N> {
         (&self.y6, &self.k[4])
     }
 
-    /// Component i of the dense output at t + θh, θ ∈ [0, 1].
-    pub fn dense(&self, i: usize, theta: f64) -> f64 {
+    /// Hairer's coefficients of component i's dense output (see [`Continuous`]).
+    fn coefficients(&self, i: usize) -> [f64; 5] {
         let [k1, k3, k4, k5, k6, k7] = &self.k;
         let h = self.h;
         let ydiff = self.y1[i] - self.y0[i];
         let bspl = h * k1[i] - ydiff;
         let r4 = ydiff - h * k7[i] - bspl;
         let r5 = h * (D1 * k1[i] + D3 * k3[i] + D4 * k4[i] + D5 * k5[i] + D6 * k6[i] + D7 * k7[i]);
-        let theta1 = 1.0 - theta;
-        self.y0[i] + theta * (ydiff + theta1 * (bspl + theta * (r4 + theta1 * r5)))
+        [self.y0[i], ydiff, bspl, r4, r5]
+    }
+
+    /// Component i of the dense output at t + θh, θ ∈ [0, 1].
+    pub fn dense(&self, i: usize, theta: f64) -> f64 {
+        hairer(&self.coefficients(i), theta)
+    }
+
+    /// The dense output of every component, its coefficients computed once (for a step that
+    /// serves many points).
+    pub fn continuous(&self) -> Continuous<N> {
+        Continuous {
+            rows: std::array::from_fn(|i| self.coefficients(i)),
+        }
+    }
+}
+
+/// y0 + θ(Δ + (1−θ)(b + θ(r4 + (1−θ) r5))): Hairer's form of DOPRI5's continuous extension.
+#[inline]
+fn hairer(c: &[f64; 5], theta: f64) -> f64 {
+    let theta1 = 1.0 - theta;
+    c[0] + theta * (c[1] + theta1 * (c[2] + theta * (c[3] + theta1 * c[4])))
+}
+
+/// The dense output of one step with its coefficients precomputed: a point inside the step
+/// costs four multiply-adds per component.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Continuous<const N: usize> {
+    #[serde(with = "super::serde_array::rows")]
+    rows: [[f64; 5]; N],
+}
+
+impl<const N: usize> Continuous<N> {
+    /// The state at t + θh, θ ∈ [0, 1].
+    #[inline]
+    pub fn at(&self, theta: f64) -> [f64; N] {
+        std::array::from_fn(|i| hairer(&self.rows[i], theta))
     }
 }
 

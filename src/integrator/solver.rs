@@ -115,7 +115,11 @@ struct Accepted<const N: usize> {
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 struct Ahead<const N: usize> {
     t0: f64,
-    step: dopri5::Trial<N>,
+    h: f64,
+    /// The step's dense output.
+    dense: dopri5::Continuous<N>,
+    #[serde(with = "super::serde_array")]
+    y1: [f64; N],
     /// The edge the step ends on, to be crossed when a call goes past it.
     edge: Option<Edge>,
     /// What the caller was given last: a call that starts from anything else drops the step.
@@ -127,7 +131,7 @@ struct Ahead<const N: usize> {
 impl<const N: usize> Ahead<N> {
     /// Where the kept step ends.
     fn t1(&self) -> f64 {
-        self.t0 + self.step.h
+        self.t0 + self.h
     }
 
     /// Whether a call from (t, y) continues from where the last one left off. The time may
@@ -139,10 +143,7 @@ impl<const N: usize> Ahead<N> {
 
     /// (t, y) at t_end inside the step, handed out and remembered.
     fn serve(&mut self, t: &mut f64, y: &mut [f64; N], t_end: f64) {
-        let theta = (t_end - self.t0) / self.step.h;
-        for (i, yi) in y.iter_mut().enumerate() {
-            *yi = self.step.dense(i, theta);
-        }
+        *y = self.dense.at((t_end - self.t0) / self.h);
         *t = t_end;
         self.t_out = t_end;
         self.y_out = *y;
@@ -236,10 +237,17 @@ impl<const N: usize> Solver<N> {
         self.stepper.invalidate();
     }
 
-    /// Whether `advance` from (t, y) to t_end will be served from the step kept from the
-    /// last call alone (no stepping, so it cannot fail).
-    pub fn serves(&self, t: f64, y: &[f64; N], t_end: f64) -> bool {
-        matches!(&self.ahead, Some(a) if a.continued_by(t, y) && t_end <= a.t1())
+    /// Moves (t, y) to t_end inside the step kept from the last call, if that call left off
+    /// at (t, y) and the step reaches t_end: no stepping, so it cannot fail. False, with
+    /// nothing changed, otherwise.
+    pub fn serve(&mut self, t: &mut f64, y: &mut [f64; N], t_end: f64) -> bool {
+        match &mut self.ahead {
+            Some(a) if a.continued_by(*t, y) && t_end <= a.t1() => {
+                a.serve(t, y, t_end);
+                true
+            }
+            _ => false,
+        }
     }
 
     /// Step size the next step will try.
@@ -264,17 +272,16 @@ impl<const N: usize> Solver<N> {
         y: &mut [f64; N],
         t_end: f64,
     ) -> Result<(), SolverError> {
-        if let Some(mut ahead) = self.ahead.take() {
+        if self.serve(t, y, t_end) {
+            return Ok(());
+        }
+        if let Some(ahead) = self.ahead.take() {
             if !ahead.continued_by(*t, y) {
                 // Not where the last call left off: k1 was f at the step's end.
                 self.k1_valid = false;
-            } else if t_end <= ahead.t1() {
-                ahead.serve(t, y, t_end);
-                self.ahead = Some(ahead);
-                return Ok(());
             } else {
                 *t = ahead.t1();
-                *y = ahead.step.y1;
+                *y = ahead.y1;
                 if let Some(edge) = ahead.edge {
                     self.cross(sys, edge, *t, y);
                 }
@@ -400,7 +407,9 @@ impl<const N: usize> Solver<N> {
     ) {
         let mut ahead = Ahead {
             t0: *t,
-            step,
+            h: step.h,
+            dense: step.continuous(),
+            y1: step.y1,
             edge,
             t_out: t_end,
             y_out: *y,
