@@ -216,8 +216,15 @@ pub fn calls(scenes: &[Scene], import: &Fmi2Import) {
         }
     }
     let med: Vec<f64> = cpu.iter().map(|c| median(c)).collect();
-    println!("S1 1 s at rtol {rtol:e}, median CPU of {} interleaved runs:", cpu[0].len());
+    println!(
+        "S1 1 s at rtol {rtol:e}, median CPU of {} interleaved runs:",
+        cpu[0].len()
+    );
     for (i, (name, _)) in runs.iter().enumerate() {
-        println!("  {name:20} {:8.3} ms  ({:.2}x the first)", med[i] * 1e3, med[i] / med[0]);
+        println!(
+            "  {name:20} {:8.3} ms  ({:.2}x the first)",
+            med[i] * 1e3,
+            med[i] / med[0]
+        );
     }
 }
