@@ -2,6 +2,8 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::math;
+
 /// Tolerances: the error of component i is weighed by atol[i] + rtol·max(|y0_i|, |y1_i|).
 /// Only the first `controlled` components enter the norm (the others are quadratures
 /// carried along, like dissipated energies).
@@ -65,11 +67,15 @@ impl Controller {
                 h_next: h * MIN_FACTOR,
             };
         }
-        let fac11 = err.powf(EXPONENT);
+        // err^EXPONENT and the PI term to 1e-4 through `math`'s coarse log2 and exp2, not
+        // powf: the next step waits for them, and their accuracy does not matter.
+        let log_err = math::log2_coarse(err);
         if err <= 1.0 {
-            let fac = (fac11 / self.previous_error.powf(BETA) / SAFETY)
-                .clamp(1.0 / MAX_FACTOR, 1.0 / MIN_FACTOR);
-            let mut h_next = h / fac;
+            let log_previous = math::log2_coarse(self.previous_error);
+            // SAFETY / fac, fac = err^EXPONENT / previous^BETA / SAFETY clamped to [1/5, 10].
+            let growth = (SAFETY * math::exp2_coarse(BETA * log_previous - EXPONENT * log_err))
+                .clamp(MIN_FACTOR, MAX_FACTOR);
+            let mut h_next = h * growth;
             if self.rejected_last {
                 h_next = h_next.min(h);
             }
@@ -83,7 +89,7 @@ impl Controller {
             self.rejected_last = true;
             Verdict {
                 accept: false,
-                h_next: h / (fac11 / SAFETY).min(1.0 / MIN_FACTOR),
+                h_next: h * (SAFETY * math::exp2_coarse(-EXPONENT * log_err)).max(MIN_FACTOR),
             }
         }
     }
