@@ -100,9 +100,9 @@ pub enum Method {
 /// An accepted step, whichever method took it.
 struct Accepted<const N: usize> {
     y1: [f64; N],
-    /// The DOPRI5 step itself (its last stage is f(t + h, y1); its dense output serves the
-    /// points inside it); None for Radau IIA.
-    explicit: Option<dopri5::Trial<N>>,
+    /// Taken by DOPRI5: the trial buffer holds the step (its last stage is f(t + h, y1); its
+    /// dense output serves the points inside it). False for Radau IIA.
+    explicit: bool,
     h_next: f64,
     /// The edge the step leaves its piece through, and at which fraction of the step.
     edge: Option<(Edge, f64)>,
@@ -289,6 +289,8 @@ impl<const N: usize> Solver<N> {
         }
         let mut steps = 0u64;
         let mut crossings_here = 0u32;
+        // The DOPRI5 steps are written here in place (see `dopri5::step`).
+        let mut trial = dopri5::Trial::empty();
         while *t < t_end {
             if !self.just_crossed && sys.settle(*t, y) > 0 {
                 self.invalidate();
@@ -312,7 +314,7 @@ impl<const N: usize> Solver<N> {
                 });
             }
             let start = Start { t: *t, y, k1: &k1 };
-            let step = match self.attempt(sys, start, h) {
+            let step = match self.attempt(sys, start, h, &mut trial) {
                 Ok(step) => step,
                 Err(h_next) => {
                     self.stats.rejected += 1;
@@ -330,9 +332,9 @@ impl<const N: usize> Solver<N> {
             {
                 // The edge lies past t_end: the step redone to end on it is kept ahead, t_end
                 // served from it, and the edge crossed when a call goes past it.
-                let trial = self.explicit_step(sys, start, theta * h);
+                self.explicit_step(sys, start, theta * h, &mut trial);
                 self.h = step.h_next.max(theta * h);
-                self.keep_ahead(trial, Some(edge), t, y, t_end);
+                self.keep_ahead(&trial, Some(edge), t, y, t_end);
                 return Ok(());
             }
             if let Some((edge, theta)) = step.edge {
@@ -340,7 +342,7 @@ impl<const N: usize> Solver<N> {
                 // as the step gives it (not moved onto the edge: where the force is not zero
                 // there, that would add or remove energy at every crossing).
                 if theta > 0.0 {
-                    let Some(y_edge) = self.redo(sys, start, theta * h) else {
+                    let Some(y_edge) = self.redo(sys, start, theta * h, &mut trial) else {
                         self.h = 0.5 * theta * h;
                         continue;
                     };
@@ -359,17 +361,15 @@ impl<const N: usize> Solver<N> {
             }
             crossings_here = 0;
             self.just_crossed = false;
-            match &step.explicit {
-                Some(trial) => self.k1 = *trial.k_end(),
-                None => self.k1_valid = false,
+            if step.explicit {
+                self.k1 = *trial.k_end();
+            } else {
+                self.k1_valid = false;
             }
-            if let Some(trial) = step.explicit
-                && step_past
-                && *t + h > t_end
-            {
+            if step.explicit && step_past && *t + h > t_end {
                 self.h = step.h_next;
                 self.hand_over(step.h_rho);
-                self.keep_ahead(trial, None, t, y, t_end);
+                self.keep_ahead(&trial, None, t, y, t_end);
                 return Ok(());
             }
             *t = if last { t_end } else { *t + h };
@@ -399,7 +399,7 @@ impl<const N: usize> Solver<N> {
     /// if any) and hands out (t_end, y(t_end)) from its dense output.
     fn keep_ahead(
         &mut self,
-        step: dopri5::Trial<N>,
+        step: &dopri5::Trial<N>,
         edge: Option<Edge>,
         t: &mut f64,
         y: &mut [f64; N],
@@ -425,6 +425,7 @@ impl<const N: usize> Solver<N> {
         sys: &S,
         at: Start<N>,
         h: f64,
+        trial_buffer: &mut dopri5::Trial<N>,
     ) -> Result<Accepted<N>, f64> {
         let (lo, hi) = sys.piece();
         let guard = (S::GUARD, S::RATE);
@@ -436,13 +437,14 @@ impl<const N: usize> Solver<N> {
             }
             Ok(Accepted {
                 y1: trial.y1,
-                explicit: None,
+                explicit: false,
                 h_next: verdict.h_next,
                 edge: locate_edge(&trial, guard, lo, hi),
                 h_rho: 0.0,
             })
         } else {
-            let trial = self.explicit_step(sys, at, h);
+            self.explicit_step(sys, at, h, trial_buffer);
+            let trial = &*trial_buffer;
             let mut err = self.tol.norm(&trial.y0, &trial.y1, &trial.err);
             if self.just_crossed && sys.rough_start() {
                 err *= FIRST_STEP_DISTRUST;
@@ -454,13 +456,13 @@ impl<const N: usize> Solver<N> {
             Ok(Accepted {
                 y1: trial.y1,
                 h_next: verdict.h_next,
-                edge: locate_edge(&trial, guard, lo, hi),
+                edge: locate_edge(trial, guard, lo, hi),
                 h_rho: if self.method == Method::Auto {
-                    stiffness(&trial, &self.tol)
+                    stiffness(trial, &self.tol)
                 } else {
                     0.0
                 },
-                explicit: Some(trial),
+                explicit: true,
             })
         }
     }
@@ -472,24 +474,27 @@ impl<const N: usize> Solver<N> {
         sys: &S,
         at: Start<N>,
         h: f64,
+        trial: &mut dopri5::Trial<N>,
     ) -> Option<[f64; N]> {
         if self.implicit {
             let trial = self.implicit_step(sys, at, h);
             trial.converged().then_some(trial.y1)
         } else {
-            Some(self.explicit_step(sys, at, h).y1)
+            self.explicit_step(sys, at, h, trial);
+            Some(trial.y1)
         }
     }
 
-    /// A DOPRI5 trial, with its work counted.
+    /// A DOPRI5 trial into `trial`, with its work counted.
     fn explicit_step<S: Piecewise<N>>(
         &mut self,
         sys: &S,
         at: Start<N>,
         h: f64,
-    ) -> dopri5::Trial<N> {
+        trial: &mut dopri5::Trial<N>,
+    ) {
         self.stats.rhs_evals += EVALS_PER_STEP;
-        dopri5::step(sys, at.t, at.y, at.k1, h)
+        dopri5::step(sys, at.t, at.y, at.k1, h, trial);
     }
 
     /// A Radau IIA trial, with its work counted and the spectral radius of a new Jacobian
