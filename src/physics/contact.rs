@@ -199,8 +199,7 @@ impl ContactLaw {
     /// δ ∈ [0, ε] on F−: s = ½(1 − sin(π/ε (ε/2 ∓ δ))) = sin²(π δ / (2ε)).
     #[inline]
     fn smoothing(&self, delta: f64) -> f64 {
-        let s = (self.half_pi_over_eps * delta).sin();
-        s * s
+        crate::math::sin_squared(self.half_pi_over_eps * delta)
     }
 
     /// Contact force for ξ, ξ' with the formula of `region` (MODEL.md §2).
