@@ -44,6 +44,31 @@ impl Sine {
     }
 }
 
+/// The main shaft over an interval [t0, t1]: its speeds at both ends and the angle turned,
+/// computed as a difference of motion, not of two large angles.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Span {
+    pub omega0: f64,
+    pub omega1: f64,
+    /// θ_M(t1) − θ_M(t0) [rad].
+    pub angle: f64,
+}
+
+impl Sine {
+    /// ω_M at t0 and t1, and θ_M(t1) − θ_M(t0) = ω̄ (t1 − t0) − A/w² (sin wt1 − sin wt0),
+    /// with one sine and cosine per end.
+    pub fn span(&self, t0: f64, t1: f64) -> Span {
+        let (s0, c0) = crate::math::sin_cos(self.w * t0);
+        let (s1, c1) = crate::math::sin_cos(self.w * t1);
+        let a_over_w = self.amplitude / self.w;
+        Span {
+            omega0: self.omega_mean - a_over_w * c0,
+            omega1: self.omega_mean - a_over_w * c1,
+            angle: self.omega_mean * (t1 - t0) - a_over_w / self.w * (s1 - s0),
+        }
+    }
+}
+
 /// Taylor polynomial of the main shaft about t0: θ0 + ω0 τ + α0 τ²/2 (τ = t − t0).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Polynomial {
@@ -97,6 +122,30 @@ impl Excitation {
             Excitation::Polynomial(p) => p.at(t),
         }
     }
+
+    /// The shaft over [t0, t1] (see [`Span`]).
+    pub fn span(&self, t0: f64, t1: f64) -> Span {
+        match self {
+            Excitation::Sine(s) => s.span(t0, t1),
+            Excitation::Polynomial(p) => {
+                let (a, b) = (t0 - p.t0, t1 - p.t0);
+                let s = &p.at_t0;
+                Span {
+                    omega0: s.omega + a * s.alpha,
+                    omega1: s.omega + b * s.alpha,
+                    angle: (b - a) * (s.omega + 0.5 * s.alpha * (a + b)),
+                }
+            }
+        }
+    }
+
+    /// The largest |a_M| at any time: A for the sine, |α| for the polynomial.
+    pub fn max_acceleration(&self) -> f64 {
+        match self {
+            Excitation::Sine(s) => s.amplitude.abs(),
+            Excitation::Polynomial(p) => p.at_t0.alpha.abs(),
+        }
+    }
 }
 
 #[cfg(test)]
@@ -114,5 +163,28 @@ mod tests {
             assert!(((p.omega - m.omega) / (2.0 * h) - c.alpha).abs() < 1e-4);
         }
         assert_eq!(s.at(0.0).alpha, 0.0);
+    }
+
+    /// A span's speeds are those of `at`, and its angle the difference of the angles, for
+    /// both excitations.
+    #[test]
+    fn span_is_a_difference_of_motion() {
+        let sine = Excitation::Sine(Sine::new(300.0, 30.0, 84.0));
+        let poly = Excitation::Polynomial(Polynomial {
+            t0: 0.2,
+            at_t0: Shaft {
+                theta: 1.0,
+                omega: -40.0,
+                alpha: 900.0,
+            },
+        });
+        for e in [sine, poly] {
+            let (t0, t1) = (0.2031, 0.2107);
+            let span = e.span(t0, t1);
+            let diff = e.at(t1).theta - e.at(t0).theta;
+            assert!((span.angle - diff).abs() < 1e-13, "{e:?}");
+            assert_eq!(span.omega0, e.at(t0).omega);
+            assert_eq!(span.omega1, e.at(t1).omega);
+        }
     }
 }
