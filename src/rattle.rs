@@ -10,7 +10,7 @@ pub mod torque;
 use serde::{Deserialize, Serialize};
 
 use crate::integrator::{Edge, Jacobian, Piecewise, System, Tolerance};
-use crate::physics::{Dynamics, Excitation, GearParams, Region, Shaft};
+use crate::physics::{Dynamics, Excitation, Flight, GearParams, Region, Shaft};
 
 /// Components of the state vector.
 pub const XI: usize = 0;
@@ -174,8 +174,10 @@ impl Jacobian<N> for Rattle {
 /// components `XI`, `XI_DOT` of its `N`-state (names resolved where it is used): the pieces
 /// are the contact law's regions, and crossing out of the gap counts an impact.
 macro_rules! contact_pieces {
-    ($gear:ty) => {
+    ($gear:ty $(, $extra:item)*) => {
         impl $crate::integrator::Piecewise<N> for $gear {
+            $($extra)*
+
             const GUARD: usize = XI;
             const RATE: usize = XI_DOT;
 
@@ -201,7 +203,39 @@ macro_rules! contact_pieces {
 }
 pub(crate) use contact_pieces;
 
-contact_pieces!(Rattle);
+contact_pieces!(
+    Rattle,
+    /// The gap is crossed in closed form ([`Flight`]): the free flight under the imposed
+    /// motion of the main shaft.
+    fn has_exact(&self) -> bool {
+        self.region == Region::Gap
+    },
+    fn exact(&self, t0: f64, y0: &State, t: f64) -> State {
+        let f = self.flight(t0, y0).at(t);
+        let mut y = *y0;
+        y[XI] = f.xi;
+        y[XI_DOT] = f.xi_dot;
+        y[E_LUBRICANT] += f.e_lubricant;
+        // No contact force in the gap: E_CONTACT and W_SHAFT stay.
+        y
+    },
+    fn guard_acceleration_bound(&self, t0: f64, y0: &State) -> f64 {
+        self.flight(t0, y0).acceleration_bound()
+    }
+);
+
+impl Rattle {
+    /// The free flight from (t0, y0).
+    fn flight(&self, t0: f64, y0: &State) -> Flight<'_> {
+        Flight {
+            params: &self.dynamics.params,
+            excitation: &self.excitation,
+            t0,
+            xi0: y0[XI],
+            xi_dot0: y0[XI_DOT],
+        }
+    }
+}
 
 #[cfg(test)]
 mod tests {

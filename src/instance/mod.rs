@@ -443,7 +443,7 @@ impl Instance {
     pub fn do_step(&mut self, current: f64, h: f64) -> FmiResult {
         if !(h > 0.0 && h.is_finite()) {
             return Err(FmiError::error(format!(
-                "communicationStepSize = {h:e} refused: it must be finite and > 0"
+                "communicationStepSize = {h:e} at t = {current} refused: it must be finite and > 0"
             )));
         }
         let sim = self.sim.as_mut().expect("initialised");
@@ -456,6 +456,14 @@ impl Instance {
         }
         sim.t = current;
         let t_end = current + h;
+        // Late in a long run a small step may not exist on the time axis (at t = 1e9 s the
+        // spacing of doubles is 1.2e-7 s): refused rather than stretched or shrunk.
+        let resolved = t_end - current;
+        if (resolved - h).abs() > 1e-3 * h {
+            return Err(FmiError::error(format!(
+                "communicationStepSize = {h:e} at t = {current} is below the resolution of time there (t + h - t = {resolved:e} s): refused"
+            )));
+        }
         // What the event log compares with, taken only when that log is on.
         let before = self.logging[EVENTS].then(|| (sim.impacts(), sim.stats().switches));
         match sim.step_to(t_end) {

@@ -4,6 +4,8 @@
 //!   Nørsett & Wanner, *Solving ODEs I*, II.5), one step at a time.
 //! - [`control`]: the error norm (atol + rtol·|y| per component) and the step-size controller.
 //! - [`roots`]: the Illinois root finder used to locate edges on the dense output.
+//! - `passage`: pieces with a solution in closed form (the free flight), crossed without
+//!   steps, their exit found by a root search that cannot step over a crossing.
 //! - [`radau5`]: the Radau IIA method of order 5 for stiff phases, one step at a time.
 //! - [`stiffness`]: when to hand over from one method to the other.
 //! - [`solver`]: the driver that reaches an exact end time, carries the step size and method
@@ -13,6 +15,7 @@
 pub mod control;
 pub mod dopri5;
 pub mod linalg;
+mod passage;
 pub mod radau5;
 pub mod roots;
 pub mod serde_array;
@@ -65,6 +68,25 @@ pub trait Piecewise<const N: usize>: System<N> {
     /// smooth at the start of the first step, whose error estimate the solver distrusts.
     fn rough_start(&self) -> bool {
         false
+    }
+
+    /// Whether the current piece has a solution in closed form ([`Piecewise::exact`]): the
+    /// solver then takes no steps in it and finds where the solution leaves the piece by a
+    /// root search on it.
+    fn has_exact(&self) -> bool {
+        false
+    }
+
+    /// Where the piece has one: the state at t ≥ t0 from y0 at t0 in the current piece.
+    fn exact(&self, _t0: f64, y0: &[f64; N], _t: f64) -> [f64; N] {
+        *y0
+    }
+
+    /// With [`Piecewise::exact`]: a bound on |d² y[GUARD] / dt²| along the exact solution
+    /// from (t0, y0) on, for as long as it stays in the piece. It is what keeps the root
+    /// search from stepping over a crossing.
+    fn guard_acceleration_bound(&self, _t0: f64, _y0: &[f64; N]) -> f64 {
+        f64::INFINITY
     }
 
     /// Moves to the piece that contains `y[GUARD]` through each edge on the way (after a

@@ -13,6 +13,7 @@
 
 use super::control::{Controller, Tolerance};
 use super::dopri5::{self, EVALS_PER_STEP};
+use super::passage::Passage;
 use super::radau5::{Jacobian, RadauTrial, Stepper};
 use super::roots::illinois;
 use super::stiffness::{Switch, spectral_radius, stiffness};
@@ -34,6 +35,8 @@ pub struct Stats {
     pub decompositions: u64,
     /// Hand-overs between DOPRI5 and Radau IIA.
     pub switches: u64,
+    /// Evaluations of a piece's solution in closed form (the free flight), in place of steps.
+    pub exact_evals: u64,
 }
 
 /// Why the solver stopped short of the end time. The state is left at the last good point.
@@ -45,6 +48,9 @@ pub enum SolverError {
     TooManySteps { t: f64, steps: u64 },
     /// The state keeps crossing edges without advancing in time.
     Chattering { t: f64 },
+    /// The root search on a piece's exact solution made no headway (a guard creeping along
+    /// an edge).
+    SearchStalled { t: f64 },
 }
 
 impl std::fmt::Display for SolverError {
@@ -64,6 +70,12 @@ impl std::fmt::Display for SolverError {
             }
             SolverError::Chattering { t } => {
                 write!(f, "edge crossings without progress in time at t = {t} s")
+            }
+            SolverError::SearchStalled { t } => {
+                write!(
+                    f,
+                    "the search for the end of a free flight stalled at t = {t} s"
+                )
             }
         }
     }
@@ -190,6 +202,8 @@ pub struct Solver<const N: usize> {
     /// of the piece it left, and must not be sent back there.
     just_crossed: bool,
     ahead: Option<Ahead<N>>,
+    /// The passage through a piece with an exact solution, kept from the last call.
+    passage: Option<Passage<N>>,
 }
 
 impl<const N: usize> Solver<N> {
@@ -216,6 +230,7 @@ impl<const N: usize> Solver<N> {
             k1_valid: false,
             just_crossed: false,
             ahead: None,
+            passage: None,
         }
     }
 
@@ -234,20 +249,36 @@ impl<const N: usize> Solver<N> {
         self.k1_valid = false;
         self.just_crossed = false;
         self.ahead = None;
+        self.passage = None;
         self.stepper.invalidate();
     }
 
-    /// Moves (t, y) to t_end inside the step kept from the last call, if that call left off
-    /// at (t, y) and the step reaches t_end: no stepping, so it cannot fail. False, with
-    /// nothing changed, otherwise.
-    pub fn serve(&mut self, t: &mut f64, y: &mut [f64; N], t_end: f64) -> bool {
-        match &mut self.ahead {
-            Some(a) if a.continued_by(*t, y) && t_end <= a.t1() => {
-                a.serve(t, y, t_end);
-                true
-            }
-            _ => false,
+    /// Moves (t, y) to t_end inside the step or the passage kept from the last call, if that
+    /// call left off at (t, y) and what was kept reaches t_end: no stepping or search, so it
+    /// cannot fail. False, with nothing changed, otherwise.
+    pub fn serve<S: Piecewise<N>>(
+        &mut self,
+        sys: &S,
+        t: &mut f64,
+        y: &mut [f64; N],
+        t_end: f64,
+    ) -> bool {
+        if let Some(a) = &mut self.ahead
+            && a.continued_by(*t, y)
+            && t_end <= a.t1()
+        {
+            a.serve(t, y, t_end);
+            return true;
         }
+        if let Some(p) = &mut self.passage
+            && p.continued_by(*t, y)
+            && t_end <= p.t_clear
+        {
+            p.serve(sys, t, y, t_end);
+            self.stats.exact_evals += 1;
+            return true;
+        }
+        false
     }
 
     /// Step size the next step will try.
@@ -272,7 +303,7 @@ impl<const N: usize> Solver<N> {
         y: &mut [f64; N],
         t_end: f64,
     ) -> Result<(), SolverError> {
-        if self.serve(t, y, t_end) {
+        if self.serve(sys, t, y, t_end) {
             return Ok(());
         }
         if let Some(ahead) = self.ahead.take() {
@@ -294,6 +325,12 @@ impl<const N: usize> Solver<N> {
         while *t < t_end {
             if !self.just_crossed && sys.settle(*t, y) > 0 {
                 self.invalidate();
+            }
+            if sys.has_exact() {
+                if self.pass(sys, t, y, t_end)? {
+                    continue;
+                }
+                return Ok(());
             }
             let k1 = self.derivative(sys, *t, y);
             if self.h <= 0.0 {
@@ -383,6 +420,48 @@ impl<const N: usize> Solver<N> {
             self.hand_over(step.h_rho);
         }
         Ok(())
+    }
+
+    /// Through a piece with an exact solution (see `passage`): to t_end, or to where the
+    /// solution leaves the piece, crossing that edge (true). The passage is kept for the next
+    /// call while it continues.
+    fn pass<S: Piecewise<N>>(
+        &mut self,
+        sys: &mut S,
+        t: &mut f64,
+        y: &mut [f64; N],
+        t_end: f64,
+    ) -> Result<bool, SolverError> {
+        let mut passage = match self.passage.take() {
+            Some(p) if p.continued_by(*t, y) => p,
+            _ => Passage::new(sys, *t, y),
+        };
+        // Close enough to an edge to cross it: a thousandth of the guard's absolute
+        // tolerance, or a few rounding errors of the edges.
+        let (lo, hi) = sys.piece();
+        let scale = [lo, hi]
+            .iter()
+            .filter(|b| b.is_finite())
+            .fold(0.0f64, |m, b| m.max(b.abs()));
+        let tol = (1e-3 * self.tol.atol[S::GUARD]).max(16.0 * f64::EPSILON * scale);
+        let evals = passage
+            .search(sys, t_end, tol)
+            .ok_or(SolverError::SearchStalled { t: *t })?;
+        self.stats.exact_evals += evals;
+        match passage.exit {
+            Some(edge) if passage.t_clear <= t_end => {
+                *t = passage.t_clear;
+                *y = passage.y_clear;
+                self.cross(sys, edge, *t, y);
+                Ok(true)
+            }
+            _ => {
+                passage.serve(sys, t, y, t_end);
+                self.stats.exact_evals += 1;
+                self.passage = Some(passage);
+                Ok(false)
+            }
+        }
     }
 
     /// Crosses `edge` at (t, y): the system changes piece, and what was known of the old one
