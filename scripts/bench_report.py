@@ -213,6 +213,9 @@ def parse_profile(text):
     m = re.search(r"work: (\d+) RHS, (\d+) accepted \+ (\d+) rejected steps, (\d+) edges", text)
     if m:
         p["rhs"], p["accepted"], p["rejected"], p["edges"] = map(int, m.groups())
+    m = re.search(r"free flight in closed form: (\d+) evaluations of the exact solution", text)
+    if m:
+        p["flight_evals"] = int(m.group(1))
     m = re.search(r"RHS per accepted step ([0-9.]+); RHS on edges .*? ([0-9.]+) % ; RHS on rejected steps .*? ([0-9.]+) %", text)
     if m:
         p["rhs_per_step"], p["edge_pct"], p["reject_pct"] = map(float, m.groups())
@@ -244,11 +247,11 @@ def analysis(rows, s1, r_rust, n_rust, r_user, n_user, r_py, n_py, comm_rows, to
         a(f"**Against the Rust crates ({pc / gr_c:.2f}× at 1e-9 m on S1, target 3×).** The crates run here with "
           "GearRattle's own event handling (band edges located on the dense output, steps ending on them, "
           "restart in the next region), the same right-hand-side function and the same error weights, so what "
-          "is left to compare is the implementation of one explicit pair against another. At 1e-9 m on S1 (1 s) "
+          "is left to compare is the integrator: GearRattle's DOPRI5, which crosses the gap in closed form, "
+          "against each crate's pair, which integrates it. At 1e-9 m on S1 (1 s) "
           f"GearRattle spends {gr_h:.3g} RHS against {ph:.3g} for {pn} ({ph / gr_h:.2f}×), at "
           f"{gr_c / gr_h * 1e9:.0f} ns of CPU per RHS against {pc / ph * 1e9:.0f} ns "
-          f"({pc / ph / (gr_c / gr_h):.2f}×): GearRattle's lead is the product of the two, a few tens of per cent each, "
-          "not a factor 3.")
+          f"({pc / ph / (gr_c / gr_h):.2f}×): GearRattle's lead is the product of the two.")
         a("")
     if gr_c and r_user is not None:
         uc, _, uh = s1[n_user]
@@ -277,18 +280,22 @@ def analysis(rows, s1, r_rust, n_rust, r_user, n_user, r_py, n_py, comm_rows, to
               f"Right-hand sides take {p['rhs_cpu']:.0f} % of the CPU time; the integrator around them (stages, "
               f"error norm, step control, edge search, output stops) {p['other_cpu']:.0f} %, i.e. "
               f"{p['other_ns']:.0f} ns per RHS. By region: contact {contact_pct:.0f} % of the RHS, bands "
-              f"{band_pct:.0f} %, free flight {gap['pct']:.0f} %. Edges cost {p['edge_pct']:.0f} % of the RHS "
+              f"{band_pct:.0f} %, free flight {gap['pct']:.0f} %" +
+              (f" (the gap is crossed in closed form: {p['flight_evals']} evaluations of the exact solution "
+               "instead of steps)" if "flight_evals" in p else "") +
+              f". Edges cost {p['edge_pct']:.0f} % of the RHS "
               f"(each: the step redone to land on it and a new first stage), rejected steps {p['reject_pct']:.0f} %.")
             a("")
-            a("Levers of issue 3, with the most each could give here (the share it could remove, as a speed-up "
-              "bound):")
+            a("Levers of issue 3 in place: steps end on the band edges; the gap is crossed in closed form (a root "
+              "search on the exact free flight that cannot step over a crossing); a cheap right-hand side (table "
+              "cube root, the excitation's sine and cosine by fdlibm's kernels, inlined, the band's sin² as a polynomial, no powf for "
+              "α = 4/3); no allocation on the stepping path (each DOPRI5 step written in place); the step-size "
+              "controller's powers by a coarse log2/exp2; outputs computed only when read. What is left, with the "
+              "most each could give here (the share it could remove, as a speed-up bound):")
             a("")
-            gap_cpu = gap["cpu"]
             levers = [
-                ("closed-form free flight (no RHS in the gap; a root search on the exact solution instead)",
-                 gap_cpu),
                 ("a cheaper right-hand side (all RHS time; by region: " +
-                 ", ".join(f"{k.split(' (')[0]} {v['ns']:.0f} ns" for k, v in reg.items()) + ")",
+                 ", ".join(f"{k.split(' (')[0]} {v['ns']:.0f} ns" for k, v in reg.items() if v["count"]) + ")",
                  p["rhs_cpu"]),
                 ("leaner stepping (the integrator's own time per RHS: stages on 5 states, error norm, control, "
                  "edge search)", p["other_cpu"]),
@@ -315,40 +322,41 @@ def analysis(rows, s1, r_rust, n_rust, r_user, n_user, r_py, n_py, comm_rows, to
             for ln in perf_lines:
                 m = re.match(r"\s+([0-9.]+)%\s+\[.\]\s+(.*)", ln)
                 if m:
-                    perf[m.group(2)] = float(m.group(1))
+                    perf[re.sub(r"(\s+-)+\s*$", "", m.group(2)).strip()] = float(m.group(1))
 
-            def share(*keys):
-                return sum(v for k, v in perf.items() if any(x in k for x in keys))
-
-            cbrt, trig, pw = share("cbrt"), share("sincos", "__sin", "__cos"), share("pow")
+            libm = {k: v for k, v in perf.items() if k.startswith("__") and v >= 1}
             if perf:
-                a(f"What the profile says: the RHS and the step are now the bulk (the cube root, gear_rattle::math::cbrt, "
-                  "and the excitation's sine and cosine, math::sin_cos, are inlined into the RHS; the step-size "
-                  f"controller still calls `powf` twice per step). Library calls left: sin/cos {trig:.0f} % (the band's sine, glibc's), pow "
-                  f"{pw:.0f} %" + (f", cbrt {cbrt:.0f} %" if cbrt >= 1 else "") + ". Closed-form free flight would "
-                  f"remove only the gap's {gap['cpu']:.0f} % (free flight is short here: {gap['pct']:.0f} % of the "
-                  f"RHS), the edges cost {p['edge_pct']:.0f} % of the RHS, rejected steps {p['reject_pct']:.0f} %.")
+                a("What the profile says: the right-hand side (with the cube root and the excitation's sine and "
+                  "cosine inlined into it) and the DOPRI5 step are the bulk. Library calls above 1 %: " +
+                  (", ".join(f"{k} {v:.0f} %" for k, v in libm.items()) if libm else "none") + ".")
                 a("")
                 a("Against the integrator-only peers the RHS lever does not move the ratio, since they call the "
                   "same RHS; it moves it against the peers as users write them, and it moves the absolute cost, "
-                  "which is what a user sees. Against peers with the same RHS and the same edge handling, 3× is out "
-                  "of reach of any listed lever: it would take fewer steps than a 5(4) pair can take (MODEL.md: "
-                  "higher orders did not pay either), i.e. removing the steps themselves (closed-form free flight, "
-                  "and the same idea inside contacts, e.g. a linearised contact step).")
+                  "which is what a user sees. Against peers with the same RHS and the same edge handling, 3× would "
+                  "take fewer steps inside the contacts and bands, where the steps now are (MODEL.md: higher orders "
+                  "did not pay, each band crossing costs 2-3 steps whatever the order): a step that follows the "
+                  "contact's own oscillation, e.g. a linearised contact step, is the lever not yet tried.")
                 a("")
     if comm_rows:
         key = [cr for cr in comm_rows if tol_1e9 and math.isclose(cr[0], tol_1e9)] or comm_rows[:1]
         rtol, cf, cs, rh, er = key[0]
+        calls = 1e5  # DoSteps of S1 (1 s) at 10 µs
+        per_call = (cf[1e-5] - cf[1e-2]) / calls * 1e9
+        per_step_to = (cs[1e-5] - cs[1e-2]) / calls * 1e9
         a(f"**Communication steps** (rtol {rtol:g}): {rh[1e-2]:.3g} RHS for 1 s at 10 ms, {rh[1e-3]:.3g} at 1 ms, "
           f"{rh[1e-4]:.3g} at 0.1 ms, {rh[1e-5]:.3g} at 10 µs; CPU at 10 µs is {cf[1e-5] / cf[1e-2]:.1f}× that at 10 ms. "
           "In sine mode the FMU serves communication points from the dense output of its natural DOPRI5 steps "
-          "and resumes from their ends (Solver::interpolate_ends), so the steps, and the RHS count, are those of "
-          "a run without communication points; what is left at 10 µs is the cost of each DoStep call itself "
-          "(argument checks, the state copy kept for a failed step, the interpolation, the outputs read). "
+          "and from the closed-form free flight, and resumes from where they end (Solver::interpolate_ends and "
+          "the kept passage), so the steps, and the RHS count, are those of a run without communication points. "
+          "What is left at 10 µs is the cost of each call: "
+          f"{per_call:.0f} ns per fmi2DoStep + fmi2GetReal (ξ, ξ') through the C API, of which "
+          f"{per_step_to:.0f} ns in Simulation::step_to and the outputs themselves (the interpolation, or one "
+          "evaluation of the flight, with its exponential and two sines, in the gap), against "
+          f"{cf[1e-2] * 1e3:.2f} ms of integration per simulated second: 100 000 calls cost "
+          f"{per_call * 1e5 * 1e-6:.1f} ms. "
           "In inputs mode new inputs arrive at every DoStep and steps still end on the communication points. "
-          f"FMI overhead at 0.1 ms: {(cf[1e-4] / cs[1e-4] - 1) * 100:+.0f} % (C API against Simulation::step_to; "
-          "the same copies and checks are in both, the difference is the C boundary, argument checks and the "
-          "fmi crate's wrappers).")
+          f"FMI overhead at 0.1 ms: {(cf[1e-4] / cs[1e-4] - 1) * 100:+.0f} % (C API against Simulation::step_to: "
+          "the C boundary, the guard around each call, argument checks and the fmi crate's wrappers).")
         a("")
     if r_py is not None:
         a(f"**Against scipy** ({r_py:.0f}× at 1e-9 m on S1, fastest {n_py}): a Python RHS costs microseconds where "
@@ -446,6 +454,10 @@ def main() -> None:
         cs = {c: fnum(st[c]["cpu_median"]) for c in st}
         comm_rows.append((rtol, cf, cs, {c: fnum(st[c]["rhs_evals"]) for c in st},
                           {c: fnum(fm[c]["err_max_xi"]) for c in fm}))
+    # The FMU runs at the decades only: the loosest decade where GearRattle reaches 1e-9 m.
+    fmu_tols = [cr[0] for cr in comm_rows]
+    tol_1e9 = next((rt for rt, e, c, h in curve(rows, GR, "S1-1s")
+                    if e <= TARGET and any(math.isclose(rt, t) for t in fmu_tols)), tol_1e9)
     key_tols = [t for t in (tol_1e9, 1e-6) if t is not None]
     comm_key = [cr for cr in comm_rows if any(math.isclose(cr[0], t) for t in key_tols)]
     worst_comm = max((cr[1][1e-5] / cr[1][1e-2] for cr in comm_key), default=math.nan)
@@ -563,9 +575,12 @@ def main() -> None:
       "1e-2·G (MODEL.md §5). Beyond it (S2 1 s) the impact rates per flank over 0.2-1 s are compared instead.")
     w("- Cost: CPU time of the calling thread (Rust: CLOCK_THREAD_CPUTIME_ID; Python: process_time), median of "
       "interleaved repeats (Rust: 3-9 within a 1.5 s budget per group; Python: 3 when a run is under 2 s, else 1); "
+      "tolerances: the Rust integrators at every half decade from 1e-3 to 1e-10 (so that the interpolation at "
+      "equal error brackets closely), the FMU runs and the Python peers at the decades; "
       "RHS evaluations as counted in the RHS itself (peers) or by the integrator (GearRattle).")
     w("- GearRattle (direct): `Rattle` + `Solver::advance` to each 1 ms grid point, served from the dense output "
-      "of its natural steps (`interpolate_ends`, as the FMU in sine mode). Simulation::step_to: the FMU's simulation object stepped at the communication step "
+      "of its natural steps (`interpolate_ends`, as the FMU in sine mode), the gap crossed in closed form (its "
+      "evaluations of the exact flight are not counted as RHS). Simulation::step_to: the FMU's simulation object stepped at the communication step "
       "without FMI, outputs read after each step; the FMI overhead is the FMU through the C API "
       "(`fmi` crate 0.8: fmi2DoStep + fmi2GetReal of ξ, ξ' each step) against it.")
     w("- Rust crates: the same RHS function (`Rattle`'s, so one evaluation costs the same everywhere and the "

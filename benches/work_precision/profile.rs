@@ -54,6 +54,15 @@ impl Piecewise<N> for Counted {
     fn cross(&mut self, edge: Edge, t: f64, y: &State) {
         self.inner.cross(edge, t, y)
     }
+    fn has_exact(&self) -> bool {
+        self.inner.has_exact()
+    }
+    fn exact(&self, t0: f64, y0: &State, t: f64) -> State {
+        self.inner.exact(t0, y0, t)
+    }
+    fn guard_acceleration_bound(&self, t0: f64, y0: &State) -> f64 {
+        self.inner.guard_acceleration_bound(t0, y0)
+    }
 }
 
 /// CPU nanoseconds per call of `rhs` at ξ = xi, ξ' = 0.05 m/s (300 000 calls at moving times).
@@ -69,7 +78,8 @@ fn ns_per_rhs(rhs: impl Fn(f64, &State) -> State, xi: f64) -> f64 {
     (cpu_now() - t0) / n as f64 * 1e9
 }
 
-pub fn run(scenes: &[Scene]) {
+/// S1 (1 s), BENCH_PROFILE_RTOL (default `rtol`) and BENCH_PROFILE_SECONDS (default 4).
+fn setup(scenes: &[Scene], rtol: f64) -> (&Scene, f64, f64) {
     let sc = scenes
         .iter()
         .find(|s| s.name == "S1-1s")
@@ -80,8 +90,15 @@ pub fn run(scenes: &[Scene]) {
             .and_then(|v| v.parse().ok())
             .unwrap_or(d)
     };
-    let rtol = env("BENCH_PROFILE_RTOL", 1e-9);
-    let seconds = env("BENCH_PROFILE_SECONDS", 4.0);
+    (
+        sc,
+        env("BENCH_PROFILE_RTOL", rtol),
+        env("BENCH_PROFILE_SECONDS", 4.0),
+    )
+}
+
+pub fn run(scenes: &[Scene]) {
+    let (sc, rtol, seconds) = setup(scenes, 1e-9);
 
     // 1. The plain run, repeated (what perf samples).
     let start = cpu_now();
@@ -139,6 +156,11 @@ pub fn run(scenes: &[Scene]) {
         run.rhs, solver.stats.accepted, solver.stats.rejected, run.edges
     );
     println!(
+        "free flight in closed form: {} evaluations of the exact solution, {} RHS in the gap",
+        solver.stats.exact_evals,
+        evals[index(Region::Gap)]
+    );
+    println!(
         "RHS per accepted step {:.2}; RHS on edges (redo of the step to land on the edge + new first \
          stage, 7 per edge) {:.0} % ; RHS on rejected steps (6 each) {:.0} %",
         run.rhs as f64 / solver.stats.accepted as f64,
@@ -182,18 +204,7 @@ pub fn run(scenes: &[Scene]) {
 /// and the C API at 10 ms and 10 µs, interleaved for BENCH_PROFILE_SECONDS (default 4) of
 /// CPU; BENCH_PROFILE_ONLY=fmu|steps runs only that one at 10 µs (for `perf record`).
 pub fn calls(scenes: &[Scene], import: &Fmi2Import) {
-    let sc = scenes
-        .iter()
-        .find(|s| s.name == "S1-1s")
-        .expect("scene S1-1s in the reference");
-    let env = |k: &str, d: f64| {
-        std::env::var(k)
-            .ok()
-            .and_then(|v| v.parse().ok())
-            .unwrap_or(d)
-    };
-    let rtol = env("BENCH_PROFILE_RTOL", 1e-7);
-    let seconds = env("BENCH_PROFILE_SECONDS", 4.0);
+    let (sc, rtol, seconds) = setup(scenes, 1e-7);
     let only = std::env::var("BENCH_PROFILE_ONLY").ok();
     type Runner<'a> = Box<dyn Fn() -> Outcome + 'a>;
     let mut runs: Vec<(&str, Runner)> = vec![
