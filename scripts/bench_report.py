@@ -458,7 +458,7 @@ def main() -> None:
     fmu_tols = [cr[0] for cr in comm_rows]
     tol_1e9 = next((rt for rt, e, c, h in curve(rows, GR, "S1-1s")
                     if e <= TARGET and any(math.isclose(rt, t) for t in fmu_tols)), tol_1e9)
-    key_tols = [t for t in (tol_1e9, 1e-6) if t is not None]
+    key_tols = sorted({t for t in (tol_1e9, 1e-6) if t is not None}, reverse=True)
     comm_key = [cr for cr in comm_rows if any(math.isclose(cr[0], t) for t in key_tols)]
     worst_comm = max((cr[1][1e-5] / cr[1][1e-2] for cr in comm_key), default=math.nan)
     worst_fmi = max((cr[1][1e-4] / cr[2][1e-4] - 1 for cr in comm_key), default=math.nan)
