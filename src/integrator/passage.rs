@@ -96,16 +96,26 @@ impl<const N: usize> Passage<N> {
         Some(evals)
     }
 
-    /// The state at t_end ≤ t_clear, handed out and remembered.
-    pub fn serve<S: Piecewise<N>>(&mut self, sys: &S, t: &mut f64, y: &mut [f64; N], t_end: f64) {
-        *y = if t_end == self.t_clear {
-            self.y_clear
+    /// The state at t_end ≤ t_clear, handed out and remembered; returns the number of
+    /// evaluations of the exact solution it took (none at t_clear itself).
+    pub fn serve<S: Piecewise<N>>(
+        &mut self,
+        sys: &S,
+        t: &mut f64,
+        y: &mut [f64; N],
+        t_end: f64,
+    ) -> u64 {
+        let evals = if t_end == self.t_clear {
+            *y = self.y_clear;
+            0
         } else {
-            sys.exact(self.t0, &self.y0, t_end)
+            *y = sys.exact(self.t0, &self.y0, t_end);
+            1
         };
         *t = t_end;
         self.t_out = t_end;
         self.y_out = *y;
+        evals
     }
 }
 
