@@ -14,6 +14,7 @@
 
 pub mod control;
 pub mod dopri5;
+mod left_off;
 pub mod linalg;
 mod passage;
 pub mod radau5;

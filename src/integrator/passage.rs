@@ -14,6 +14,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::left_off::LeftOff;
 use super::{Edge, Piecewise};
 
 /// Largest number of evaluations of the exact solution in one call's search.
@@ -32,11 +33,8 @@ pub(super) struct Passage<const N: usize> {
     #[serde(with = "super::serde_array")]
     pub y_clear: [f64; N],
     pub exit: Option<Edge>,
-    /// What the caller was given last: a call that starts from anything else drops the
-    /// passage.
-    t_out: f64,
-    #[serde(with = "super::serde_array")]
-    y_out: [f64; N],
+    /// What the caller was given last.
+    left_off: LeftOff<N>,
 }
 
 impl<const N: usize> Passage<N> {
@@ -49,15 +47,13 @@ impl<const N: usize> Passage<N> {
             t_clear: t,
             y_clear: *y,
             exit: None,
-            t_out: t,
-            y_out: *y,
+            left_off: LeftOff::at(t, y),
         }
     }
 
-    /// Whether a call from (t, y) continues from where the last one left off (a few ulps of
-    /// time are the same point, as for the solver's kept step).
+    /// Whether a call from (t, y) continues from where the last one left off.
     pub fn continued_by(&self, t: f64, y: &[f64; N]) -> bool {
-        (t - self.t_out).abs() <= 4.0 * f64::EPSILON * self.t_out.abs() && *y == self.y_out
+        self.left_off.continued_by(t, y)
     }
 
     /// Extends the search until it is clear past t_end or has found the exit; returns the
@@ -113,8 +109,7 @@ impl<const N: usize> Passage<N> {
             1
         };
         *t = t_end;
-        self.t_out = t_end;
-        self.y_out = *y;
+        self.left_off = LeftOff::at(t_end, y);
         evals
     }
 }

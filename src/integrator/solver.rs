@@ -17,6 +17,7 @@
 
 use super::control::{Controller, Tolerance};
 use super::dopri5::{self, EVALS_PER_STEP};
+use super::left_off::LeftOff;
 use super::passage::Passage;
 use super::radau5::{Jacobian, RadauTrial, Stepper};
 use super::roots::illinois;
@@ -138,10 +139,8 @@ struct Ahead<const N: usize> {
     y1: [f64; N],
     /// The edge the step ends on, to be crossed when a call goes past it.
     edge: Option<Edge>,
-    /// What the caller was given last: a call that starts from anything else drops the step.
-    t_out: f64,
-    #[serde(with = "super::serde_array")]
-    y_out: [f64; N],
+    /// What the caller was given last.
+    left_off: LeftOff<N>,
 }
 
 impl<const N: usize> Ahead<N> {
@@ -150,19 +149,15 @@ impl<const N: usize> Ahead<N> {
         self.t0 + self.h
     }
 
-    /// Whether a call from (t, y) continues from where the last one left off. The time may
-    /// come back rounded differently (a master passing k·h where t_end was (k−1)·h + h): a
-    /// few ulps are the same point; the state must be the same bits.
     fn continued_by(&self, t: f64, y: &[f64; N]) -> bool {
-        (t - self.t_out).abs() <= 4.0 * f64::EPSILON * self.t_out.abs() && *y == self.y_out
+        self.left_off.continued_by(t, y)
     }
 
     /// (t, y) at t_end inside the step, handed out and remembered.
     fn serve(&mut self, t: &mut f64, y: &mut [f64; N], t_end: f64) {
         *y = self.dense.at((t_end - self.t0) / self.h);
         *t = t_end;
-        self.t_out = t_end;
-        self.y_out = *y;
+        self.left_off = LeftOff::at(t_end, y);
     }
 }
 
@@ -492,8 +487,7 @@ impl<const N: usize> Solver<N> {
             dense: step.continuous(),
             y1: step.y1,
             edge,
-            t_out: t_end,
-            y_out: *y,
+            left_off: LeftOff::at(t_end, y),
         };
         ahead.serve(t, y, t_end);
         self.ahead = Some(ahead);
