@@ -420,6 +420,15 @@ def param_note(p, meta):
     return "paper's parameters except " + ", ".join(f"{k} = {v:g}" for k, v in meta["set"].items())
 
 
+def power_fit(fs, a):
+    """Least squares of ln a on ln f: (a at 30 Hz, exponent), or None with fewer than 2 points."""
+    ok = np.isfinite(a)
+    if np.count_nonzero(ok) < 2:
+        return None
+    pw, c = np.polyfit(np.log(fs[ok]), np.log(a[ok]), 1)
+    return np.exp(c) * 30 ** pw, pw
+
+
 def threshold_figure(thr, out, meta, grid_range, p):
     thr = sorted(thr, key=lambda t: t["f_Hz"])
     fs = np.array([t["f_Hz"] for t in thr])
@@ -441,18 +450,13 @@ def threshold_figure(thr, out, meta, grid_range, p):
         ax.plot(*zip(*iso), "x", color="tab:red", ms=5, ls="none",
                 label="isolated sustaining levels below the onset (scan)")
     ax.fill_between(fs, np.ones_like(a1), a1, color="0.85", lw=0, label="no impact at all")
-    ok = np.isfinite(a2)
-    if np.count_nonzero(ok) >= 2:
-        pw, c = np.polyfit(np.log(fs[ok]), np.log(a2[ok]), 1)
-        ax.semilogy(fs, np.exp(c) * fs ** pw, ":", color="tab:red", lw=1,
-                    label=rf"fit $A_{{sustained}} \approx {np.exp(c) * 30 ** pw:.2f}\,"
-                          rf"(f/30\,\mathrm{{Hz}})^{{{pw:.2f}}}$")
-    ok = np.isfinite(a1)
-    if np.count_nonzero(ok) >= 2:
-        pw, c = np.polyfit(np.log(fs[ok]), np.log(a1[ok]), 1)
-        ax.semilogy(fs, np.exp(c) * fs ** pw, ":", color="tab:blue", lw=1,
-                    label=rf"fit $A_{{first}} \approx {np.exp(c) * 30 ** pw:.2f}\,"
-                          rf"(f/30\,\mathrm{{Hz}})^{{{pw:.2f}}}$")
+    for a, name, color in ((a2, "sustained", "tab:red"), (a1, "first", "tab:blue")):
+        fit = power_fit(fs, a)
+        if fit:
+            at30, pw = fit
+            ax.semilogy(fs, at30 * (fs / 30) ** pw, ":", color=color, lw=1,
+                        label=rf"fit $A_{{{name}}} \approx {at30:.2f}\,"
+                              rf"(f/30\,\mathrm{{Hz}})^{{{pw:.2f}}}$")
     ax.set_ylim(1, 1500)
     ax.set_xlim(fs[0] - 1, fs[-1] + 1)
     ax.set_xticks(fs)
@@ -723,7 +727,13 @@ def summary_lines(rows, thr, fs, As, p, meta):
         L.append(f"  {sims} threshold runs; {retr} levels needed a retry after an FMU step "
                  f"failure (see threshold.csv, fmu_errors); {fails} levels failed at every "
                  f"output interval and 0.1 % nudge (left out of the search)")
+        f_thr = np.array([t["f_Hz"] for t in thr])
         a2 = np.array([t["A_sustained"] for t in thr])
+        for key, name in (("A_first", "first impact"), ("A_sustained", "sustained rattle")):
+            fit = power_fit(f_thr, np.array([t[key] for t in thr]))
+            if fit:
+                L.append(f"  fit of the {name} (least squares of ln A on ln f): "
+                         f"{fit[0]:.2f} (f/30 Hz)^{fit[1]:.2f}")
         if np.any(np.isfinite(a2)):
             L.append(f"  highest onset of sustained rattle: {np.nanmax(a2):.3g} rad/s^2, "
                      f"{As[0] / np.nanmax(a2):.1f}x below the lowest level of the grid "

@@ -10,7 +10,7 @@ pub mod torque;
 use serde::{Deserialize, Serialize};
 
 use crate::integrator::{Edge, Jacobian, Piecewise, System, Tolerance};
-use crate::physics::{Dynamics, Excitation, Flight, GearParams, Region, Shaft};
+use crate::physics::{Dynamics, Excitation, Flight, GearParams, Loads, Region, Shaft};
 
 /// Components of the state vector.
 pub const XI: usize = 0;
@@ -83,23 +83,6 @@ pub trait GearPair<const N: usize>: Piecewise<N> {
     fn shaft(&self, t: f64, y: &[f64; N]) -> Shaft;
 }
 
-impl GearPair<N> for Rattle {
-    const E_CONTACT: usize = E_CONTACT;
-    const E_LUBRICANT: usize = E_LUBRICANT;
-    fn dynamics(&self) -> &Dynamics {
-        &self.dynamics
-    }
-    fn region(&self) -> Region {
-        self.region
-    }
-    fn impacts(&self) -> &Impacts {
-        &self.impacts
-    }
-    fn shaft(&self, t: f64, _y: &State) -> Shaft {
-        self.excitation.at(t)
-    }
-}
-
 /// Share of the requested tolerance given to each step's local error. The request is read as
 /// a bound on the error after a few impacts, and the local errors of the steps add up: on the
 /// 37 stress cases (tests/python/stress_cases.py, rtol 1e-8, windows of two impacts) the whole
@@ -141,15 +124,22 @@ impl System<N> for Rattle {
         let shaft = self.excitation.at(t);
         let loads = self.dynamics.loads(self.region, y[XI], y[XI_DOT], &shaft);
         let p = &self.dynamics.params;
-        let slip = loads.omega_L - p.omega_S;
-        [
-            y[XI_DOT],
-            loads.xi_ddot,
-            loads.force.dissipative * y[XI_DOT],
-            p.C * slip * slip,
-            -p.r_M * loads.force.total() * shaft.omega,
-        ]
+        let [e_contact, e_lubricant, w_shaft] = power_flows(p, &loads, y[XI_DOT], shaft.omega);
+        [y[XI_DOT], loads.xi_ddot, e_contact, e_lubricant, w_shaft]
     }
+}
+
+/// The rates of the quadratures (MODEL.md §3's energy balance): the power lost in the contact
+/// damping F_c ξ', in the lubricant C (ω_L − ω_S)², and the power −τ_M ω_M the main shaft
+/// feeds in.
+#[inline]
+pub(crate) fn power_flows(p: &GearParams, loads: &Loads, xi_dot: f64, omega_M: f64) -> [f64; 3] {
+    let slip = loads.omega_L - p.omega_S;
+    [
+        loads.force.dissipative * xi_dot,
+        p.C * slip * slip,
+        -p.r_M * loads.force.total() * omega_M,
+    ]
 }
 
 impl Jacobian<N> for Rattle {
@@ -170,11 +160,28 @@ impl Jacobian<N> for Rattle {
     }
 }
 
-/// `Piecewise` for a gear pair with fields `dynamics`, `region` and `impacts`, and ξ, ξ' at the
-/// components `XI`, `XI_DOT` of its `N`-state (names resolved where it is used): the pieces
-/// are the contact law's regions, and crossing out of the gap counts an impact.
+/// `GearPair` and `Piecewise` for a gear pair with fields `dynamics`, `region` and `impacts`,
+/// and ξ, ξ', the energies at the components `XI`, `XI_DOT`, `E_CONTACT`, `E_LUBRICANT` of its
+/// `N`-state (names resolved where it is used). `$shaft` is the pair's `GearPair::shaft`; the
+/// pieces are the contact law's regions, and crossing out of the gap counts an impact;
+/// `$extra` items go into the `Piecewise` impl.
 macro_rules! contact_pieces {
-    ($gear:ty $(, $extra:item)*) => {
+    ($gear:ty, $shaft:item $(, $extra:item)*) => {
+        impl $crate::rattle::GearPair<N> for $gear {
+            const E_CONTACT: usize = E_CONTACT;
+            const E_LUBRICANT: usize = E_LUBRICANT;
+            fn dynamics(&self) -> &$crate::physics::Dynamics {
+                &self.dynamics
+            }
+            fn region(&self) -> $crate::physics::Region {
+                self.region
+            }
+            fn impacts(&self) -> &$crate::rattle::Impacts {
+                &self.impacts
+            }
+            $shaft
+        }
+
         impl $crate::integrator::Piecewise<N> for $gear {
             $($extra)*
 
@@ -205,6 +212,9 @@ pub(crate) use contact_pieces;
 
 contact_pieces!(
     Rattle,
+    fn shaft(&self, t: f64, _y: &State) -> Shaft {
+        self.excitation.at(t)
+    },
     /// The gap is crossed in closed form ([`Flight`]): the free flight under the imposed
     /// motion of the main shaft.
     fn has_exact(&self) -> bool {

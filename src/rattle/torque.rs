@@ -15,7 +15,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::{GearPair, Impacts, LOCAL_SHARE, contact_pieces, scales};
+use super::{Impacts, LOCAL_SHARE, contact_pieces, power_flows, scales};
 pub use super::{XI, XI_DOT};
 use crate::integrator::{Jacobian, System, Tolerance};
 use crate::physics::{Dynamics, Loads, MainShaft, Region, Shaft, TorqueRamp};
@@ -89,37 +89,20 @@ impl TorqueRattle {
     }
 }
 
-impl GearPair<N> for TorqueRattle {
-    const E_CONTACT: usize = E_CONTACT;
-    const E_LUBRICANT: usize = E_LUBRICANT;
-    fn dynamics(&self) -> &Dynamics {
-        &self.dynamics
-    }
-    fn region(&self) -> Region {
-        self.region
-    }
-    fn impacts(&self) -> &Impacts {
-        &self.impacts
-    }
-    fn shaft(&self, t: f64, y: &State) -> Shaft {
-        self.loads(t, y).1
-    }
-}
-
 impl System<N> for TorqueRattle {
     #[inline]
     fn rhs(&self, t: f64, y: &State) -> State {
         let (loads, shaft) = self.loads(t, y);
         let p = &self.dynamics.params;
-        let slip = loads.omega_L - p.omega_S;
+        let [e_contact, e_lubricant, w_shaft] = power_flows(p, &loads, y[XI_DOT], shaft.omega);
         [
             y[XI_DOT],
             loads.xi_ddot,
             shaft.omega,
             shaft.alpha,
-            loads.force.dissipative * y[XI_DOT],
-            p.C * slip * slip,
-            -p.r_M * loads.force.total() * shaft.omega,
+            e_contact,
+            e_lubricant,
+            w_shaft,
         ]
     }
 }
@@ -163,7 +146,12 @@ impl Jacobian<N> for TorqueRattle {
     }
 }
 
-contact_pieces!(TorqueRattle);
+contact_pieces!(
+    TorqueRattle,
+    fn shaft(&self, t: f64, y: &State) -> Shaft {
+        self.loads(t, y).1
+    }
+);
 
 #[cfg(test)]
 mod tests {

@@ -129,8 +129,9 @@ class Slave:
         cats = (fmi2String * n)(*[c.encode() for c in categories])
         return self._status(self.fmu.fmi2SetDebugLogging, self.fmu.component, 1 if on else 0, n, cats)
 
-    def setup(self):
-        return self._status(self.fmu.fmi2SetupExperiment, self.fmu.component, 0, 0.0, 0.0, 0, 0.0)
+    def setup(self, start=0.0):
+        self.t = start
+        return self._status(self.fmu.fmi2SetupExperiment, self.fmu.component, 0, 0.0, start, 0, 0.0)
 
     def enter_init(self):
         return self._status(self.fmu.fmi2EnterInitializationMode, self.fmu.component)
@@ -145,9 +146,9 @@ class Slave:
     def terminate(self):
         return self._status(self.fmu.fmi2Terminate, self.fmu.component)
 
-    def init(self, reals=None, integers=None):
+    def init(self, reals=None, integers=None, start=0.0):
         """setupExperiment, enter, set start values, exit; all must be OK."""
-        assert self.setup() == fmi2OK
+        assert self.setup(start) == fmi2OK
         assert self.enter_init() == fmi2OK
         if integers:
             assert self.set_integer([self.vrs[k] for k in integers], list(integers.values())) == fmi2OK
@@ -253,6 +254,17 @@ def test_negative_communication_step(slave):
     assert slave.real("xi") == pytest.approx(0.5 * R.DEFAULTS["G"], abs=1e-15)
     # the refused call changed nothing: stepping on from the same time works
     assert slave.do_step(1e-4) == fmi2OK
+    assert math.isfinite(slave.real("xi"))
+
+
+def test_communication_step_below_the_resolution_of_time(slave):
+    """At t = 1e9 s doubles lie 1.2e-7 s apart: a step of 1e-7 s cannot be taken as asked."""
+    slave.init(start=1e9)
+    m = slave.mark()
+    assert slave.do_step(1e-7) in REFUSED
+    slave.assert_logged(m, "resolution of time")
+    # the refused call changed nothing: a step the time axis resolves goes on
+    assert slave.do_step(1e-3) == fmi2OK
     assert math.isfinite(slave.real("xi"))
 
 
