@@ -5,8 +5,9 @@ use serde::{Deserialize, Serialize};
 use crate::math;
 
 /// Tolerances: the error of component i is weighed by atol[i] + rtol·max(|y0_i|, |y1_i|).
-/// Only the first `controlled` components enter the norm (the others are quadratures
-/// carried along, like dissipated energies).
+/// Only the first `controlled` components enter the norm. The others are quadratures
+/// carried along, like dissipated energies: the right-hand side must not read them (DOPRI5's
+/// stages do not form them, see `dopri5::step`).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Tolerance<const N: usize> {
     pub rtol: f64,

@@ -569,7 +569,7 @@ impl<const N: usize> Solver<N> {
         trial: &mut dopri5::Trial<N>,
     ) {
         self.stats.rhs_evals += EVALS_PER_STEP;
-        dopri5::step(sys, at.t, at.y, at.k1, h, trial);
+        dopri5::step(sys, at.t, at.y, at.k1, h, self.tol.controlled, trial);
     }
 
     /// A Radau IIA trial, with its work counted and the spectral radius of a new Jacobian

@@ -143,7 +143,7 @@ mod tests {
             }
         }
         let mut trial = dopri5::Trial::empty();
-        dopri5::step(&Scalar(-300.0), 0.0, &[1.0], &[-300.0], 0.01, &mut trial);
+        dopri5::step(&Scalar(-300.0), 0.0, &[1.0], &[-300.0], 0.01, 1, &mut trial);
         assert!((stiffness(&trial, &tolerance(1e-6, [1e-6])) - 3.0).abs() < 1e-12);
 
         // The stiff linear system under DOPRI5 with its own controller: once the fast mode has
@@ -157,7 +157,7 @@ mod tests {
         let mut fired_at = None;
         while t < 1e-3 && fired_at.is_none() {
             let mut trial = dopri5::Trial::empty();
-            dopri5::step(&Linear, t, &y, &k1, h, &mut trial);
+            dopri5::step(&Linear, t, &y, &k1, h, 2, &mut trial);
             let verdict = controller.judge(tol.norm(&trial.y0, &trial.y1, &trial.err), h);
             if verdict.accept {
                 accepted += 1;
