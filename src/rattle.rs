@@ -10,7 +10,7 @@ pub mod torque;
 use serde::{Deserialize, Serialize};
 
 use crate::integrator::{Edge, Jacobian, Piecewise, System, Tolerance};
-use crate::physics::{Dynamics, Excitation, Flight, GearParams, Loads, Region, Shaft};
+use crate::physics::{Dynamics, Excitation, Flight, FlightStart, GearParams, Loads, Region, Shaft};
 
 /// Components of the state vector.
 pub const XI: usize = 0;
@@ -41,6 +41,9 @@ pub struct Rattle {
     pub region: Region,
     pub excitation: Excitation,
     pub impacts: Impacts,
+    /// The start of the free flight the solver is passing through, kept for its points
+    /// ([`Piecewise::prepare_exact`]).
+    flight_start: Option<FlightStart>,
 }
 
 impl Rattle {
@@ -50,6 +53,7 @@ impl Rattle {
             dynamics,
             excitation,
             impacts: Impacts::default(),
+            flight_start: None,
         }
     }
 
@@ -220,6 +224,9 @@ contact_pieces!(
     fn has_exact(&self) -> bool {
         self.region == Region::Gap
     },
+    fn prepare_exact(&mut self, t0: f64, y0: &State) {
+        self.flight_start = Some(self.flight(t0, y0).start);
+    },
     fn exact(&self, t0: f64, y0: &State, t: f64) -> State {
         let f = self.flight(t0, y0).at(t);
         let mut y = *y0;
@@ -235,14 +242,16 @@ contact_pieces!(
 );
 
 impl Rattle {
-    /// The free flight from (t0, y0).
+    /// The free flight from (t0, y0), from its kept start if it is that one.
     fn flight(&self, t0: f64, y0: &State) -> Flight<'_> {
-        Flight {
-            params: &self.dynamics.params,
-            excitation: &self.excitation,
-            t0,
-            xi0: y0[XI],
-            xi_dot0: y0[XI_DOT],
+        let (params, excitation) = (&self.dynamics.params, &self.excitation);
+        match self.flight_start {
+            Some(start) if start.is_from(t0, y0[XI], y0[XI_DOT]) => Flight {
+                params,
+                excitation,
+                start,
+            },
+            _ => Flight::new(params, excitation, t0, y0[XI], y0[XI_DOT]),
         }
     }
 }
@@ -280,5 +289,27 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// The free flight's kept start changes no bit of the exact solution, and a flight from
+    /// elsewhere does not use it.
+    #[test]
+    fn kept_flight_start_gives_the_same_bits() {
+        let p = GearParams::paper();
+        let excitation = Excitation::Sine(Sine::new(300.0, 30.0, 84.0));
+        let fresh = Rattle::new(Dynamics::new(p), excitation, 10e-6);
+        assert_eq!(fresh.region, Region::Gap);
+        let (t0, y0) = (0.0123, [10e-6, -0.04, 1e-3, 2e-3, 3e-3]);
+        let mut kept = fresh;
+        kept.prepare_exact(t0, &y0);
+        for t in [t0, 0.0124, 0.02] {
+            assert_eq!(kept.exact(t0, &y0, t), fresh.exact(t0, &y0, t));
+        }
+        let other = [11e-6, -0.04, 0.0, 0.0, 0.0];
+        assert_eq!(
+            kept.exact(t0, &other, 0.013),
+            fresh.exact(t0, &other, 0.013)
+        );
+        assert_ne!(kept.exact(t0, &other, 0.013), kept.exact(t0, &y0, 0.013));
     }
 }

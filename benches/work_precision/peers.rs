@@ -34,7 +34,7 @@ use std::cell::Cell;
 
 use gear_rattle::integrator::{Edge, Piecewise, System};
 use gear_rattle::physics::{Dynamics, Excitation, GearParams, Region};
-use gear_rattle::rattle::{Impacts, N, Rattle, State, XI, XI_DOT};
+use gear_rattle::rattle::{N, Rattle, State, XI, XI_DOT};
 
 /// MODEL.md §2, §3 and §5 written out literally: the right-hand side a user of a general ODE
 /// crate writes for the state [ξ, ξ', E_contact, E_lubricant, W_shaft], with the region taken
@@ -96,8 +96,8 @@ impl UserRhs {
 /// The gear pair's right-hand side with the region read from a cell, so that a crate's
 /// closure or trait object can follow region changes made by the driver. Counts evaluations.
 pub struct Model {
-    pub dynamics: Dynamics,
-    pub excitation: Excitation,
+    /// The gear pair; its region is the cell's.
+    pub rattle: Rattle,
     pub region: Cell<Region>,
     pub evals: Cell<u64>,
     /// The peer as a user writes it: this RHS instead of `Rattle`'s, and no event handling
@@ -108,8 +108,7 @@ pub struct Model {
 impl Model {
     pub fn new(dynamics: Dynamics, excitation: Excitation, region: Region) -> Self {
         Model {
-            dynamics,
-            excitation,
+            rattle: Rattle::new(dynamics, excitation, 0.0),
             region: Cell::new(region),
             evals: Cell::new(0),
             user: None,
@@ -123,12 +122,8 @@ impl Model {
         if let Some(user) = &self.user {
             return user.rhs(t, y);
         }
-        let rattle = Rattle {
-            dynamics: self.dynamics,
-            region: self.region.get(),
-            excitation: self.excitation,
-            impacts: Impacts::default(),
-        };
+        let mut rattle = self.rattle;
+        rattle.region = self.region.get();
         rattle.rhs(t, y)
     }
 }
@@ -286,7 +281,7 @@ pub fn drive<S: Stepper>(
     tol_xi: f64,
 ) -> Result<Run, String> {
     model.evals.set(0);
-    let mut rattle = Rattle::new(model.dynamics, model.excitation, y0[XI]);
+    let mut rattle = Rattle::new(model.rattle.dynamics, model.rattle.excitation, y0[XI]);
     model.region.set(rattle.region);
     let mut run = Run {
         xi: Vec::with_capacity(grid.len()),

@@ -57,6 +57,9 @@ impl Piecewise<N> for Counted {
     fn has_exact(&self) -> bool {
         self.inner.has_exact()
     }
+    fn prepare_exact(&mut self, t0: f64, y0: &State) {
+        self.inner.prepare_exact(t0, y0)
+    }
     fn exact(&self, t0: f64, y0: &State, t: f64) -> State {
         self.inner.exact(t0, y0, t)
     }

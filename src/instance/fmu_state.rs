@@ -10,7 +10,8 @@ use crate::contract::GUID;
 use serde::{Deserialize, Serialize};
 
 const MAGIC: &[u8; 4] = b"GRFS";
-const VERSION: u16 = 2;
+/// 3: the gear pair keeps the start of the free flight it passes through.
+const VERSION: u16 = 3;
 const HEADER: usize = 4 + 2 + 4;
 const TRAILER: usize = 4;
 

@@ -78,6 +78,11 @@ pub trait Piecewise<const N: usize>: System<N> {
         false
     }
 
+    /// Called when a passage through the piece starts from (t0, y0): what the exact solution
+    /// from there shares between its points may be computed once here. [`Piecewise::exact`]
+    /// must give the same result whether or not this was called.
+    fn prepare_exact(&mut self, _t0: f64, _y0: &[f64; N]) {}
+
     /// Where the piece has one: the state at t ≥ t0 from y0 at t0 in the current piece.
     fn exact(&self, _t0: f64, y0: &[f64; N], _t: f64) -> [f64; N] {
         *y0

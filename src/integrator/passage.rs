@@ -39,7 +39,8 @@ pub(super) struct Passage<const N: usize> {
 
 impl<const N: usize> Passage<N> {
     /// A passage starting at (t, y) in the system's current piece.
-    pub fn new<S: Piecewise<N>>(sys: &S, t: f64, y: &[f64; N]) -> Self {
+    pub fn new<S: Piecewise<N>>(sys: &mut S, t: f64, y: &[f64; N]) -> Self {
+        sys.prepare_exact(t, y);
         Passage {
             t0: t,
             y0: *y,
@@ -171,8 +172,8 @@ mod tests {
     #[test]
     fn finds_a_crossing() {
         // g = 0 first where cos ωt = 1 − ω²/(2a): a = 4, ω = 2 → cos 2t = 0.5, t = π/6.
-        let sys = Swing { a: 4.0, omega: 2.0 };
-        let mut p = Passage::new(&sys, 0.0, &[0.5, 0.0]);
+        let mut sys = Swing { a: 4.0, omega: 2.0 };
+        let mut p = Passage::new(&mut sys, 0.0, &[0.5, 0.0]);
         let evals = p.search(&sys, 10.0, 1e-12).expect("found");
         assert_eq!(p.exit, Some(Edge::Lower));
         let t_exact = std::f64::consts::PI / 6.0;
@@ -190,20 +191,20 @@ mod tests {
     #[test]
     fn neither_invents_nor_skips_a_grazing_crossing() {
         // min g = 0.5 − 2a/ω² (at ωt = π).
-        let near = Swing {
+        let mut near = Swing {
             a: (0.5 - 1e-9) / 2.0 * 4.0,
             omega: 2.0,
         };
-        let mut p = Passage::new(&near, 0.0, &[0.5, 0.0]);
+        let mut p = Passage::new(&mut near, 0.0, &[0.5, 0.0]);
         p.search(&near, 3.0, 1e-12).expect("searched");
         assert_eq!(p.exit, None, "no crossing: the swing turns back 1e-9 short");
         assert!(p.t_clear >= 3.0);
 
-        let dip = Swing {
+        let mut dip = Swing {
             a: (0.5 + 1e-8) / 2.0 * 4.0,
             omega: 2.0,
         };
-        let mut p = Passage::new(&dip, 0.0, &[0.5, 0.0]);
+        let mut p = Passage::new(&mut dip, 0.0, &[0.5, 0.0]);
         p.search(&dip, 3.0, 1e-12).expect("searched");
         assert_eq!(p.exit, Some(Edge::Lower));
         // It crosses just before ωt = π, i.e. t = π/2.

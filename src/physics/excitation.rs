@@ -54,17 +54,35 @@ pub struct Span {
     pub angle: f64,
 }
 
+/// What every span from t0 shares: the shaft's speed there and, for the sine, sin(w t0).
+/// Computed once for the many spans of a free flight ([`Excitation::span_from`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct SpanStart {
+    pub t0: f64,
+    pub omega0: f64,
+    sin0: f64,
+}
+
 impl Sine {
-    /// ω_M at t0 and t1, and θ_M(t1) − θ_M(t0) = ω̄ (t1 − t0) − A/w² (sin wt1 − sin wt0),
-    /// with one sine and cosine per end.
-    pub fn span(&self, t0: f64, t1: f64) -> Span {
-        let (s0, c0) = crate::math::sin_cos(self.w * t0);
+    /// ω_M(t0), and sin(w t0) for the angle.
+    fn span_start(&self, t0: f64) -> SpanStart {
+        let (sin0, cos0) = crate::math::sin_cos(self.w * t0);
+        SpanStart {
+            t0,
+            omega0: self.omega_mean - self.amplitude / self.w * cos0,
+            sin0,
+        }
+    }
+
+    /// ω_M at t1, and θ_M(t1) − θ_M(t0) = ω̄ (t1 − t0) − A/w² (sin wt1 − sin wt0): one sine
+    /// and cosine.
+    fn span_from(&self, start: &SpanStart, t1: f64) -> Span {
         let (s1, c1) = crate::math::sin_cos(self.w * t1);
         let a_over_w = self.amplitude / self.w;
         Span {
-            omega0: self.omega_mean - a_over_w * c0,
+            omega0: start.omega0,
             omega1: self.omega_mean - a_over_w * c1,
-            angle: self.omega_mean * (t1 - t0) - a_over_w / self.w * (s1 - s0),
+            angle: self.omega_mean * (t1 - start.t0) - a_over_w / self.w * (s1 - start.sin0),
         }
     }
 }
@@ -125,13 +143,30 @@ impl Excitation {
 
     /// The shaft over [t0, t1] (see [`Span`]).
     pub fn span(&self, t0: f64, t1: f64) -> Span {
+        self.span_from(&self.span_start(t0), t1)
+    }
+
+    /// What the spans from t0 share (see [`SpanStart`]).
+    pub fn span_start(&self, t0: f64) -> SpanStart {
         match self {
-            Excitation::Sine(s) => s.span(t0, t1),
+            Excitation::Sine(s) => s.span_start(t0),
+            Excitation::Polynomial(p) => SpanStart {
+                t0,
+                omega0: p.at(t0).omega,
+                sin0: 0.0,
+            },
+        }
+    }
+
+    /// The shaft over [start.t0, t1].
+    pub fn span_from(&self, start: &SpanStart, t1: f64) -> Span {
+        match self {
+            Excitation::Sine(s) => s.span_from(start, t1),
             Excitation::Polynomial(p) => {
-                let (a, b) = (t0 - p.t0, t1 - p.t0);
+                let (a, b) = (start.t0 - p.t0, t1 - p.t0);
                 let s = &p.at_t0;
                 Span {
-                    omega0: s.omega + a * s.alpha,
+                    omega0: start.omega0,
                     omega1: s.omega + b * s.alpha,
                     angle: (b - a) * (s.omega + 0.5 * s.alpha * (a + b)),
                 }

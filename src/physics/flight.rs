@@ -10,6 +10,9 @@
 //! "with nearly constant, slowly decaying speed", S(t) = S0 e^(−C* t)).
 #![allow(non_snake_case)]
 
+use serde::{Deserialize, Serialize};
+
+use super::excitation::SpanStart;
 use super::{Excitation, GearParams};
 
 /// The transmission error and the lubricant's dissipated energy along a free flight.
@@ -21,31 +24,64 @@ pub struct FlightState {
     pub e_lubricant: f64,
 }
 
-/// A free flight from (t0, ξ0, ξ'0) under the main shaft's imposed motion.
+/// What every point of a free flight from (t0, ξ0, ξ'0) shares: the start, the shaft there
+/// (one sine and cosine) and u0 = ω_L(t0) − ω_S. Plain data, kept along a passage through
+/// the gap so that each point costs only its own end ([`Flight::at`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct FlightStart {
+    pub xi0: f64,
+    pub xi_dot0: f64,
+    shaft: SpanStart,
+    u0: f64,
+}
+
+impl FlightStart {
+    /// Whether this is the start of a flight from (t0, ξ0, ξ'0), to the bit.
+    pub fn is_from(&self, t0: f64, xi0: f64, xi_dot0: f64) -> bool {
+        self.shaft.t0 == t0 && self.xi0 == xi0 && self.xi_dot0 == xi_dot0
+    }
+}
+
+/// A free flight under the main shaft's imposed motion.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Flight<'a> {
     pub params: &'a GearParams,
     pub excitation: &'a Excitation,
-    pub t0: f64,
-    pub xi0: f64,
-    pub xi_dot0: f64,
+    pub start: FlightStart,
 }
 
-impl Flight<'_> {
-    /// u0 = ω_L(t0) − ω_S from the shaft's speed at t0.
-    fn u0(&self, omega_M0: f64) -> f64 {
-        let p = self.params;
-        (self.xi_dot0 + p.r_M * omega_M0) / p.r_L - p.omega_S
+impl<'a> Flight<'a> {
+    /// The flight from (t0, ξ0, ξ'0).
+    pub fn new(
+        params: &'a GearParams,
+        excitation: &'a Excitation,
+        t0: f64,
+        xi0: f64,
+        xi_dot0: f64,
+    ) -> Self {
+        let shaft = excitation.span_start(t0);
+        // u0 = ω_L(t0) − ω_S from the shaft's speed at t0.
+        let u0 = (xi_dot0 + params.r_M * shaft.omega0) / params.r_L - params.omega_S;
+        Flight {
+            params,
+            excitation,
+            start: FlightStart {
+                xi0,
+                xi_dot0,
+                shaft,
+                u0,
+            },
+        }
     }
 
-    /// ξ, ξ' and the lubricant's energy at t ≥ t0: one e^(−λτ) − 1 and the shaft's span
-    /// (a sine and cosine per end) per call.
+    /// ξ, ξ' and the lubricant's energy at t ≥ t0: one e^(−λτ) − 1 and the shaft at t (a
+    /// sine and cosine) per call.
     pub fn at(&self, t: f64) -> FlightState {
         let p = self.params;
-        let span = self.excitation.span(self.t0, t);
+        let FlightStart { xi0, shaft, u0, .. } = self.start;
+        let span = self.excitation.span_from(&shaft, t);
         let lambda = p.C / p.I_L;
-        let tau = t - self.t0;
-        let u0 = self.u0(span.omega0);
+        let tau = t - shaft.t0;
         let x = lambda * tau;
         // e^(−x) − 1, exact to the last digits for small x; φ1 = τ (1 − e^(−x))/x.
         let em1 = (-x).exp_m1();
@@ -58,7 +94,7 @@ impl Flight<'_> {
             turned_L += beta * tau * tau * phi2(x);
         }
         FlightState {
-            xi: self.xi0 + (p.r_L * turned_L - p.r_M * span.angle),
+            xi: xi0 + (p.r_L * turned_L - p.r_M * span.angle),
             xi_dot: p.r_L * (p.omega_S + u) - p.r_M * span.omega1,
             e_lubricant: self.dissipated(u0, tau, x, em1),
         }
@@ -86,8 +122,7 @@ impl Flight<'_> {
     /// (ω_L' = −λ (u0 − B/C) e^(−λτ) decays, or is B/I_L when C = 0).
     pub fn acceleration_bound(&self) -> f64 {
         let p = self.params;
-        let u0 = self.u0(self.excitation.at(self.t0).omega);
-        let omega_L_dot = (p.B - p.C * u0) / p.I_L;
+        let omega_L_dot = (p.B - p.C * self.start.u0) / p.I_L;
         p.r_L * omega_L_dot.abs() + p.r_M * self.excitation.max_acceleration()
     }
 }
@@ -136,13 +171,8 @@ mod tests {
             (poly, 0.0, 0.0, 0.0),
         ] {
             (params.B, params.C, params.omega_S) = (B, C, omega_S);
-            let flight = Flight {
-                params: &params,
-                excitation: &excitation,
-                t0: 0.0123,
-                xi0: 7e-6,
-                xi_dot0: -0.04,
-            };
+            let (t0, xi0, xi_dot0) = (0.0123, 7e-6, -0.04);
+            let flight = Flight::new(&params, &excitation, t0, xi0, xi_dot0);
             let p = &params;
             let f = |t: f64, y: [f64; 3]| {
                 let shaft = excitation.at(t);
@@ -151,7 +181,7 @@ mod tests {
                 let u = omega_L - p.omega_S;
                 [y[1], p.r_L * alpha_L - p.r_M * shaft.alpha, p.C * u * u]
             };
-            let (mut t, mut y) = (flight.t0, [flight.xi0, flight.xi_dot0, 0.0]);
+            let (mut t, mut y) = (t0, [xi0, xi_dot0, 0.0]);
             let h = 1e-6;
             for _ in 0..3000 {
                 let add =
@@ -167,7 +197,7 @@ mod tests {
             }
             let exact = flight.at(t);
             // Within RK4's error and rounding: 1e-11 of the distance and speed change.
-            let (moved, sped) = ((y[0] - flight.xi0).abs(), (y[1] - flight.xi_dot0).abs());
+            let (moved, sped) = ((y[0] - xi0).abs(), (y[1] - xi_dot0).abs());
             assert!(
                 (exact.xi - y[0]).abs() < 1e-16 + 1e-11 * moved,
                 "xi {} vs {}",

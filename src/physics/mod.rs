@@ -11,6 +11,6 @@ pub mod params;
 
 pub use contact::{ContactLaw, ForceSlopes, Region};
 pub use excitation::{Excitation, Polynomial, Shaft, Sine, Span, TorqueRamp};
-pub use flight::{Flight, FlightState};
+pub use flight::{Flight, FlightStart, FlightState};
 pub use motion::{Dynamics, Loads, MainShaft};
 pub use params::{GearParams, ParamError};
