@@ -205,7 +205,8 @@ pub fn run(scenes: &[Scene]) {
 /// `BENCH_PROFILE=calls`: the cost of each communication step on S1 (1 s) at
 /// BENCH_PROFILE_RTOL (default 1e-7): GearRattle alone (1 ms grid), `Simulation::step_to`
 /// and the C API at 10 ms and 10 µs, interleaved for BENCH_PROFILE_SECONDS (default 4) of
-/// CPU; BENCH_PROFILE_ONLY=fmu|steps runs only that one at 10 µs (for `perf record`).
+/// CPU, then the split of one 10 µs call ([`call_split`]); BENCH_PROFILE_ONLY=fmu|steps runs
+/// only that one at 10 µs (for `perf record`).
 pub fn calls(scenes: &[Scene], import: &Fmi2Import) {
     let (sc, rtol, seconds) = setup(scenes, 1e-7);
     let only = std::env::var("BENCH_PROFILE_ONLY").ok();
@@ -241,4 +242,67 @@ pub fn calls(scenes: &[Scene], import: &Fmi2Import) {
             med[i] / med[0]
         );
     }
+    if only.is_none() {
+        // step_to at 10 ms: the integration of the second alone.
+        call_split(import, sc, rtol, med[1]);
+    }
+}
+
+/// Where a 10 µs call's time goes, each part timed over 100 000 calls of its own (median of
+/// 5 rounds): fmi2GetReal of ξ, ξ' alone (no step between: the C boundary, the guard and two
+/// outputs), `Simulation::real_output` of ξ alone, and 1 s of fmi2DoStep against
+/// `Simulation::step_to` (both with the integration, whose share per call is the second's
+/// `integration` CPU over the 100 000 calls).
+fn call_split(import: &Fmi2Import, sc: &Scene, rtol: f64, integration: f64) {
+    const CALLS: usize = 100_000;
+    let per_call = |start: f64| (cpu_now() - start) / CALLS as f64 * 1e9;
+    let outs = [vr::xi, vr::xi_dot];
+    let mut rounds: [Vec<f64>; 4] = Default::default();
+    for _ in 0..5 {
+        let mut inst = import
+            .instantiate_cs("split", false, false)
+            .expect("instantiate");
+        inst.setup_experiment(Some(rtol), 0.0, None).expect("setup");
+        inst.enter_initialization_mode().expect("init");
+        inst.set_integer(&[vr::excitation], &[1])
+            .expect("excitation");
+        inst.set_real(
+            &[vr::A_rms, vr::f_exc, vr::I_L, vr::C_LM],
+            &[sc.A_rms, sc.f_exc, sc.I_L, sc.C_LM],
+        )
+        .expect("parameters");
+        inst.exit_initialization_mode().expect("init");
+        let mut x = [0.0; 2];
+        let start = cpu_now();
+        for _ in 0..CALLS {
+            inst.get_real(&outs, &mut x).expect("get");
+        }
+        rounds[0].push(per_call(start));
+        let start = cpu_now();
+        for k in 1..=CALLS {
+            inst.do_step((k - 1) as f64 * 1e-5, 1e-5, true)
+                .expect("step");
+        }
+        rounds[1].push(per_call(start));
+        let mut sim = Simulation::new(&fmu_values(sc), 0.0, rtol).expect("simulation");
+        let start = cpu_now();
+        for k in 1..=CALLS {
+            sim.step_to(k as f64 * 1e-5).expect("step");
+        }
+        rounds[2].push(per_call(start));
+        let start = cpu_now();
+        let mut sink = 0.0;
+        for _ in 0..CALLS {
+            sink += sim.real_output(std::hint::black_box(vr::xi)).expect("xi");
+        }
+        std::hint::black_box(sink);
+        rounds[3].push(per_call(start));
+    }
+    let [get, step, step_to, output] = rounds.map(|r| median(&r));
+    println!(
+        "One 10 us call, median of 5 rounds of {CALLS}: fmi2GetReal (xi, xi') {get:.0} ns; \
+         fmi2DoStep {step:.0} ns against Simulation::step_to {step_to:.0} ns (both with the \
+         integration: {:.0} ns of it); Simulation::real_output (xi) {output:.0} ns",
+        integration / CALLS as f64 * 1e9
+    );
 }

@@ -71,7 +71,7 @@ impl<S: GearPair<N> + Jacobian<N> + Copy, const N: usize> Stepped<S, N> {
             xi_dot: y[S::RATE],
             e_contact: y[S::E_CONTACT],
             e_lubricant: y[S::E_LUBRICANT],
-            stats: self.solver.stats,
+            stats: &self.solver.stats,
             implicit: self.solver.is_implicit(),
         }
     }
@@ -107,7 +107,7 @@ struct Now<'a> {
     xi_dot: f64,
     e_contact: f64,
     e_lubricant: f64,
-    stats: Stats,
+    stats: &'a Stats,
     /// Radau IIA is stepping now.
     implicit: bool,
 }
@@ -275,7 +275,7 @@ impl Simulation {
 
     /// The solver's work counters.
     pub fn stats(&self) -> Stats {
-        self.now().stats
+        *self.now().stats
     }
 
     /// True while Radau IIA steps.
