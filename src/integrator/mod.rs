@@ -4,6 +4,7 @@
 //!   Nørsett & Wanner, *Solving ODEs I*, II.5), one step at a time.
 //! - [`control`]: the error norm (atol + rtol·|y| per component) and the step-size controller.
 //! - [`roots`]: the Illinois root finder used to locate edges on the dense output.
+//! - `entries`: the first step into a piece, from what was learnt of earlier entries.
 //! - `passage`: pieces with a solution in closed form (the free flight), crossed without
 //!   steps, their exit found by a root search that cannot step over a crossing.
 //! - [`radau5`]: the Radau IIA method of order 5 for stiff phases, one step at a time.
@@ -14,6 +15,7 @@
 
 pub mod control;
 pub mod dopri5;
+mod entries;
 mod left_off;
 pub mod linalg;
 mod passage;

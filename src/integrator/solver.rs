@@ -17,6 +17,7 @@
 
 use super::control::{Controller, Tolerance};
 use super::dopri5::{self, EVALS_PER_STEP};
+use super::entries::{Entries, Entry};
 use super::left_off::LeftOff;
 use super::passage::Passage;
 use super::radau5::{Jacobian, RadauTrial, Stepper};
@@ -203,6 +204,10 @@ pub struct Solver<const N: usize> {
     ahead: Option<Ahead<N>>,
     /// The passage through a piece with an exact solution, kept from the last call.
     passage: Option<Passage<N>>,
+    /// The piece just entered, until its first DOPRI5 step is judged, and what was learnt
+    /// of the first steps into each piece (see `entries`).
+    entering: Option<Entry>,
+    entries: Entries,
 }
 
 impl<const N: usize> Solver<N> {
@@ -230,6 +235,8 @@ impl<const N: usize> Solver<N> {
             just_crossed: false,
             ahead: None,
             passage: None,
+            entering: None,
+            entries: Entries::default(),
         }
     }
 
@@ -334,6 +341,16 @@ impl<const N: usize> Solver<N> {
             if self.h <= 0.0 {
                 self.h = self.initial_step(sys, *t, y, &k1, t_end - *t);
             }
+            // The first DOPRI5 step into a piece just entered starts from what was learnt of
+            // that piece's entries.
+            let entering = match self.entering.take() {
+                Some(entry) if !self.implicit => {
+                    let carried = self.h;
+                    self.h *= self.entries.ratio(&entry);
+                    Some((entry, carried))
+                }
+                _ => None,
+            };
             // Reach t_end exactly, without leaving a sliver (Hairer's 1.01), or step past it.
             let step_past = self.interpolate_ends && !self.implicit;
             let last = !step_past && *t + 1.01 * self.h >= t_end;
@@ -349,7 +366,12 @@ impl<const N: usize> Solver<N> {
                 });
             }
             let start = Start { t: *t, y, k1: &k1 };
-            let step = match self.attempt(sys, start, h, &mut trial) {
+            let attempt = self.attempt(sys, start, h, &mut trial);
+            if let Some((entry, carried)) = entering {
+                let wanted = attempt.as_ref().map_or_else(|h_next| *h_next, |s| s.h_next);
+                self.entries.learn(&entry, carried, wanted);
+            }
+            let step = match attempt {
                 Ok(step) => step,
                 Err(h_next) => {
                     self.stats.rejected += 1;
@@ -390,8 +412,8 @@ impl<const N: usize> Solver<N> {
                         return Err(SolverError::Chattering { t: *t });
                     }
                 }
-                self.cross(sys, edge, *t, y);
                 self.h = step.h_next.max(theta * h);
+                self.cross(sys, edge, *t, y);
                 continue;
             }
             crossings_here = 0;
@@ -465,6 +487,12 @@ impl<const N: usize> Solver<N> {
     /// goes.
     fn cross<S: Piecewise<N>>(&mut self, sys: &mut S, edge: Edge, t: f64, y: &[f64; N]) {
         sys.cross(edge, t, y);
+        let (lo, hi) = sys.piece();
+        self.entering = Some(Entry {
+            lo,
+            hi,
+            through: edge,
+        });
         self.stats.edges += 1;
         self.k1_valid = false;
         self.stepper.invalidate();

@@ -1,0 +1,121 @@
+//! The first DOPRI5 step into a piece after an edge. The step size carried over the edge is
+//! the one the old piece allowed, which can be far from what the new one allows: on the
+//! gear's bench scene S1 (rtol 1e-6), the first step into a smoothing band was rejected at
+//! more than half the entries (its error estimate a median 1.3 times the tolerance), and the
+//! first step into a contact was accepted at 1/150 of it, so 2x too short. A piece is
+//! entered the same way again and again (a rattling gear enters each band from the gap and
+//! from the contact at every impact), so the solver remembers, per piece and per edge it was
+//! entered through, the ratio of the step size its controller wanted there to the one carried
+//! in, and starts the next entry from the carried size times that ratio.
+
+use serde::{Deserialize, Serialize};
+
+use super::Edge;
+
+/// Pieces remembered; a system with more pieces entered in turn forgets the oldest.
+const SLOTS: usize = 8;
+/// The remembered ratio stays within [1/100, 5] (5: the controller's largest growth).
+const MIN_RATIO: f64 = 0.01;
+const MAX_RATIO: f64 = 5.0;
+
+/// A piece as the integrator sees it: its bounds, and the edge of the piece left behind.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub(super) struct Entry {
+    pub lo: f64,
+    pub hi: f64,
+    pub through: Edge,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+struct Slot {
+    entry: Entry,
+    /// ln of the ratio wanted / carried, averaged over the entries so far (each new one
+    /// weighs half).
+    log_ratio: f64,
+}
+
+/// The ratios learnt so far, oldest overwritten first.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub(super) struct Entries {
+    slots: [Option<Slot>; SLOTS],
+    next: usize,
+}
+
+impl Entries {
+    /// The factor to apply to the step size carried into `entry` (1 for a new one).
+    pub fn ratio(&self, entry: &Entry) -> f64 {
+        self.find(entry)
+            .map_or(1.0, |i| self.slots[i].map_or(1.0, |s| s.log_ratio.exp()))
+    }
+
+    /// The controller, having judged the first step into `entry`, wants `wanted` where
+    /// `carried` came over the edge.
+    pub fn learn(&mut self, entry: &Entry, carried: f64, wanted: f64) {
+        let observed = (wanted / carried).clamp(MIN_RATIO, MAX_RATIO).ln();
+        if !observed.is_finite() {
+            return;
+        }
+        match self.find(entry) {
+            Some(i) => {
+                if let Some(slot) = &mut self.slots[i] {
+                    slot.log_ratio = 0.5 * (slot.log_ratio + observed);
+                }
+            }
+            None => {
+                self.slots[self.next] = Some(Slot {
+                    entry: *entry,
+                    log_ratio: observed,
+                });
+                self.next = (self.next + 1) % SLOTS;
+            }
+        }
+    }
+
+    fn find(&self, entry: &Entry) -> Option<usize> {
+        self.slots
+            .iter()
+            .position(|s| s.is_some_and(|s| s.entry == *entry))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn entry(lo: f64, through: Edge) -> Entry {
+        Entry {
+            lo,
+            hi: lo + 1.0,
+            through,
+        }
+    }
+
+    /// A new piece keeps the carried step; a learnt one moves halfway towards each new
+    /// observation, within bounds; pieces and edges are told apart; the oldest is forgotten.
+    #[test]
+    fn learns_per_piece_and_edge() {
+        let mut e = Entries::default();
+        let a = entry(0.0, Edge::Lower);
+        assert_eq!(e.ratio(&a), 1.0);
+        e.learn(&a, 1e-4, 0.5e-4);
+        assert!((e.ratio(&a) - 0.5).abs() < 1e-15);
+        e.learn(&a, 1e-4, 2e-4);
+        assert!(
+            (e.ratio(&a) - 1.0).abs() < 1e-15,
+            "geometric mean of 0.5 and 2"
+        );
+        e.learn(&a, 1e-4, 1.0);
+        assert!(
+            (e.ratio(&a) - 5f64.sqrt()).abs() < 1e-14,
+            "growth capped at 5"
+        );
+        assert_eq!(e.ratio(&entry(0.0, Edge::Upper)), 1.0);
+        for k in 1..=SLOTS {
+            e.learn(&entry(k as f64, Edge::Upper), 1.0, 2.0);
+        }
+        assert_eq!(e.ratio(&a), 1.0, "the oldest is forgotten");
+        assert!((e.ratio(&entry(SLOTS as f64, Edge::Upper)) - 2.0).abs() < 1e-15);
+        e.learn(&a, 1.0, f64::NAN);
+        assert_eq!(e.ratio(&a), 1.0, "nothing learnt from NaN");
+    }
+}
