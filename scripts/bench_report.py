@@ -289,15 +289,19 @@ def analysis(rows, s1, r_rust, n_rust, r_user, n_user, r_py, n_py, comm_rows, to
             a("Levers of issue 3 in place: steps end on the band edges; the gap is crossed in closed form (a root "
               "search on the exact free flight that cannot step over a crossing); a cheap right-hand side (table "
               "cube root, the excitation's sine and cosine by fdlibm's kernels, inlined, the band's sin² as a polynomial, no powf for "
-              "α = 4/3); no allocation on the stepping path (each DOPRI5 step written in place); the step-size "
-              "controller's powers by a coarse log2/exp2; outputs computed only when read. What is left, with the "
-              "most each could give here (the share it could remove, as a speed-up bound):")
+              "α = 4/3); no allocation on the stepping path (each DOPRI5 step written in place); the stages form "
+              "only ξ and ξ' (the energy quadratures advance at the step's end); the first step into a piece "
+              "starts from what the earlier entries into it taught the step-size controller (`entries`: the "
+              "first step into a band was rejected at half of the entries before); the step-size controller's "
+              "powers by a coarse log2/exp2; the free flight's start computed once per passage; outputs computed "
+              "only when read. What is left, with the most each could give here (the share it could remove, as "
+              "a speed-up bound):")
             a("")
             levers = [
                 ("a cheaper right-hand side (all RHS time; by region: " +
                  ", ".join(f"{k.split(' (')[0]} {v['ns']:.0f} ns" for k, v in reg.items() if v["count"]) + ")",
                  p["rhs_cpu"]),
-                ("leaner stepping (the integrator's own time per RHS: stages on 5 states, error norm, control, "
+                ("leaner stepping (the integrator's own time per RHS: stages, error norm, control, "
                  "edge search)", p["other_cpu"]),
                 ("cheaper edges (the redone step and the new first stage per edge)",
                  p["edge_pct"] * p["rhs_cpu"] / 100 + p["edge_pct"] * p["other_cpu"] / 100),
@@ -335,7 +339,12 @@ def analysis(rows, s1, r_rust, n_rust, r_user, n_user, r_py, n_py, comm_rows, to
                   "which is what a user sees. Against peers with the same RHS and the same edge handling, 3× would "
                   "take fewer steps inside the contacts and bands, where the steps now are (MODEL.md: higher orders "
                   "did not pay, each band crossing costs 2-3 steps whatever the order): a step that follows the "
-                  "contact's own oscillation, e.g. a linearised contact step, is the lever not yet tried.")
+                  "contact's own oscillation, e.g. a linearised contact step, is the lever not yet tried. Tried and "
+                  "dropped: crossing an edge at the straddling step's dense output instead of redoing the step "
+                  "(10 % fewer RHS at rtol 1e-6, but in the stress suite (make stability) S1's error grew 2.6×, "
+                  "ε = 0's 32×, ε = 1e-9's 190× and the energy balance's 7×: three cases failed); aiming each step that would cross an edge to "
+                  "end just past it and crossing at its dense output (5 % fewer RHS, CPU unchanged within the "
+                  "A/B's noise).")
                 a("")
     if comm_rows:
         key = [cr for cr in comm_rows if tol_1e9 and math.isclose(cr[0], tol_1e9)] or comm_rows[:1]
@@ -351,9 +360,10 @@ def analysis(rows, s1, r_rust, n_rust, r_user, n_user, r_py, n_py, comm_rows, to
           "What is left at 10 µs is the cost of each call: "
           f"{per_call:.0f} ns per fmi2DoStep + fmi2GetReal (ξ, ξ') through the C API, of which "
           f"{per_step_to:.0f} ns in Simulation::step_to and the outputs themselves (the interpolation, or one "
-          "evaluation of the flight, with its exponential and two sines, in the gap), against "
+          "evaluation of the flight, with its exponential and one sine and cosine, in the gap), against "
           f"{cf[1e-2] * 1e3:.2f} ms of integration per simulated second: 100 000 calls cost "
           f"{per_call * 1e5 * 1e-6:.1f} ms. "
+          + calls_split() +
           "In inputs mode new inputs arrive at every DoStep and steps still end on the communication points. "
           f"FMI overhead at 0.1 ms: {(cf[1e-4] / cs[1e-4] - 1) * 100:+.0f} % (C API against Simulation::step_to: "
           "the C boundary, the guard around each call, argument checks and the fmi crate's wrappers).")
@@ -363,6 +373,25 @@ def analysis(rows, s1, r_rust, n_rust, r_user, n_user, r_py, n_py, comm_rows, to
           "the Rust one costs tens of nanoseconds, and solve_ivp restarts at every edge (a new first step each "
           "time). The ratio is dominated by the interpreter, not by the method.")
     return "\n".join(out)
+
+
+def calls_split() -> str:
+    """The split of one 10 µs call measured by `make bench-profile` (target/bench/calls.txt)."""
+    path = BENCH / "calls.txt"
+    if not path.is_file():
+        return ""
+    m = re.search(r"fmi2GetReal \(xi, xi'\) ([0-9]+) ns; fmi2DoStep ([0-9]+) ns against "
+                  r"Simulation::step_to ([0-9]+) ns \(both with the integration: ([0-9]+) ns of it\); "
+                  r"Simulation::real_output \(xi\) ([0-9]+) ns", path.read_text())
+    if not m:
+        return ""
+    get, step, step_to, integ, out = (int(x) for x in m.groups())
+    return (f"Timed apart (BENCH_PROFILE=calls, 100 000 calls each): fmi2GetReal of ξ and ξ' {get} ns, of which "
+            f"{out} ns per output; fmi2DoStep {step} ns against {step_to} ns for Simulation::step_to, of which "
+            f"{integ} ns are the integration's share: the C boundary and the guard cost about "
+            f"{get - 2 * out + step - step_to} ns per DoStep + GetReal pair, the served point "
+            f"{step_to - integ} ns. The 1.5× target would need the whole call under "
+            f"{0.5 * integ:.0f} ns. ")
 
 
 # ------------------------------------------------------------------------------ report
