@@ -34,6 +34,7 @@ pub fn panic_text(payload: &(dyn std::any::Any + Send)) -> String {
 }
 
 /// Runs `call` on the instance behind `c` if the current state is in `allowed`.
+#[inline]
 pub fn guard(
     c: fmi2Component,
     function: &str,
@@ -47,15 +48,38 @@ pub fn guard(
     // has not freed (the importer's side of the contract).
     let component = unsafe { &mut *(c as *mut Component) };
     let instance = &mut component.instance;
-    let outcome = catch_unwind(AssertUnwindSafe(|| {
-        if !instance.state.allows(allowed) {
-            return Err(FmiError::error(format!(
-                "illegal call sequence: {function} is not allowed in state {:?}",
-                instance.state
-            )));
-        }
-        call(instance)
-    }));
+    if !instance.state.allows(allowed) {
+        return refuse(component, function);
+    }
+    let outcome = catch_unwind(AssertUnwindSafe(|| call(instance)));
+    // The path of a call that succeeds and logs nothing: what a master's loop takes.
+    if matches!(outcome, Ok(Ok(()))) && component.instance.messages.is_empty() {
+        return fmi2_status(Status::Ok);
+    }
+    report(component, function, outcome)
+}
+
+/// A call the current state does not allow (kept out of `guard`'s path: it is rare).
+#[cold]
+#[inline(never)]
+fn refuse(component: &mut Component, function: &str) -> fmi2Status {
+    let e = FmiError::error(format!(
+        "illegal call sequence: {function} is not allowed in state {:?}",
+        component.instance.state
+    ));
+    report(component, function, Ok(Err(e)))
+}
+
+/// The status of a call that failed, panicked or queued log lines, with those lines and the
+/// reason handed to the importer's logger.
+#[cold]
+#[inline(never)]
+fn report(
+    component: &mut Component,
+    function: &str,
+    outcome: std::thread::Result<FmiResult>,
+) -> fmi2Status {
+    let instance = &mut component.instance;
     let status = match outcome {
         Ok(Ok(())) => Status::Ok,
         Ok(Err(e)) => {

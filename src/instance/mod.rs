@@ -441,29 +441,12 @@ impl Instance {
     }
 
     pub fn do_step(&mut self, current: f64, h: f64) -> FmiResult {
-        if !(h > 0.0 && h.is_finite()) {
-            return Err(FmiError::error(format!(
-                "communicationStepSize = {h:e} at t = {current} refused: it must be finite and > 0"
-            )));
-        }
         let sim = self.sim.as_mut().expect("initialised");
-        let drift = (current - sim.t).abs();
-        if !current.is_finite() || drift > 1e-9 * sim.t.abs().max(h).max(1e-3) {
-            return Err(FmiError::error(format!(
-                "currentCommunicationPoint = {current} does not match the instance's time {}",
-                sim.t
-            )));
+        if !Self::step_is_valid(current, h, sim.t) {
+            return Err(Self::step_refused(current, h, sim.t));
         }
         sim.t = current;
         let t_end = current + h;
-        // Late in a long run a small step may not exist on the time axis (at t = 1e9 s the
-        // spacing of doubles is 1.2e-7 s): refused rather than stretched or shrunk.
-        let resolved = t_end - current;
-        if (resolved - h).abs() > 1e-3 * h {
-            return Err(FmiError::error(format!(
-                "communicationStepSize = {h:e} at t = {current} is below the resolution of time there (t + h - t = {resolved:e} s): refused"
-            )));
-        }
         // What the event log compares with, taken only when that log is on.
         let before = self.logging[EVENTS].then(|| (sim.impacts(), sim.stats().switches));
         match sim.step_to(t_end) {
@@ -485,6 +468,39 @@ impl Instance {
                 )))
             }
         }
+    }
+
+    /// A finite step h > 0 from the instance's time t (to 1e-9 relative), that the time axis
+    /// can represent there to 0.1 %: late in a long run a small step may not exist (at
+    /// t = 1e9 s the spacing of doubles is 1.2e-7 s), and is refused rather than stretched or
+    /// shrunk.
+    #[inline]
+    fn step_is_valid(current: f64, h: f64, t: f64) -> bool {
+        let drift = (current - t).abs();
+        let resolved = (current + h) - current;
+        h > 0.0
+            && h.is_finite()
+            && current.is_finite()
+            && drift <= 1e-9 * t.abs().max(h).max(1e-3)
+            && (resolved - h).abs() <= 1e-3 * h
+    }
+
+    /// Why [`Instance::step_is_valid`] refused a step (kept off the path of a valid one).
+    #[cold]
+    #[inline(never)]
+    fn step_refused(current: f64, h: f64, t: f64) -> FmiError {
+        FmiError::error(if !(h > 0.0 && h.is_finite()) {
+            format!(
+                "communicationStepSize = {h:e} at t = {current} refused: it must be finite and > 0"
+            )
+        } else if !current.is_finite() || (current - t).abs() > 1e-9 * t.abs().max(h).max(1e-3) {
+            format!("currentCommunicationPoint = {current} does not match the instance's time {t}")
+        } else {
+            format!(
+                "communicationStepSize = {h:e} at t = {current} is below the resolution of time there (t + h - t = {:e} s): refused",
+                (current + h) - current
+            )
+        })
     }
 
     fn simulation(&self) -> &Simulation {
