@@ -3,6 +3,7 @@
 //!   - `$OUT_DIR/modelDescription.xml`, the FMI 2.0 model description packaged in the FMU;
 //!   - `$OUT_DIR/contract.rs`, the value references, start values and causalities the
 //!     instance uses (included by `src/contract.rs`);
+//!
 //! and restricts the cdylib's exports to the `fmi2*` functions (linker version script).
 //!
 //! The GUID is a hash of the contract file, so the XML and the binary always carry the same

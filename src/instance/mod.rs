@@ -121,12 +121,12 @@ impl Instance {
                 "startTime = {start_time} must be finite"
             )));
         }
-        if let Some(tol) = tolerance {
-            if !(tol > 0.0 && tol < 1.0) {
-                return Err(FmiError::error(format!(
-                    "tolerance = {tol:e} must lie in (0, 1)"
-                )));
-            }
+        if let Some(tol) = tolerance
+            && !(tol > 0.0 && tol < 1.0)
+        {
+            return Err(FmiError::error(format!(
+                "tolerance = {tol:e} must lie in (0, 1)"
+            )));
         }
         self.start_time = start_time;
         self.tolerance = tolerance;
