@@ -407,6 +407,24 @@ fn empty_run(capacity: usize) -> Run {
     }
 }
 
+/// Initialises an instance of the FMU for scene `sc` at `rtol` (bench sine, the scene's
+/// parameters set in initialisation mode), ready for fmi2DoStep from t = 0.
+fn init_fmu(
+    inst: &mut fmi::fmi2::instance::InstanceCS,
+    sc: &Scene,
+    rtol: f64,
+) -> Result<(), fmi::fmi2::Fmi2Error> {
+    inst.setup_experiment(Some(rtol), 0.0, None)?;
+    inst.enter_initialization_mode()?;
+    inst.set_integer(&[vr::excitation], &[1])?;
+    inst.set_real(
+        &[vr::A_rms, vr::f_exc, vr::I_L, vr::C_LM],
+        &[sc.A_rms, sc.f_exc, sc.I_L, sc.C_LM],
+    )?;
+    inst.exit_initialization_mode()?;
+    Ok(())
+}
+
 /// The packaged FMU through its C API (the `fmi` crate loads the shared library): parameters
 /// set in initialisation mode, fmi2DoStep at each communication point, xi and xi_dot read
 /// after every step. Timed from fmi2SetupExperiment to fmi2Terminate.
@@ -418,15 +436,7 @@ fn run_fmu(import: &Fmi2Import, sc: &Scene, rtol: f64, comm: f64) -> Outcome {
         .instantiate_cs("bench", false, false)
         .map_err(|e| format!("instantiate: {e:?}"))?;
     let start = cpu_now();
-    inst.setup_experiment(Some(rtol), 0.0, None).map_err(fmi)?;
-    inst.enter_initialization_mode().map_err(fmi)?;
-    inst.set_integer(&[vr::excitation], &[1]).map_err(fmi)?;
-    inst.set_real(
-        &[vr::A_rms, vr::f_exc, vr::I_L, vr::C_LM],
-        &[sc.A_rms, sc.f_exc, sc.I_L, sc.C_LM],
-    )
-    .map_err(fmi)?;
-    inst.exit_initialization_mode().map_err(fmi)?;
+    init_fmu(&mut inst, sc, rtol).map_err(fmi)?;
     let mut run = empty_run(n / every + 1);
     let outs = [vr::xi, vr::xi_dot];
     let counters = [vr::impacts_Fplus, vr::impacts_Fminus];

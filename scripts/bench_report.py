@@ -291,8 +291,7 @@ def analysis(rows, s1, r_rust, n_rust, r_user, n_user, r_py, n_py, comm_rows, to
               "cube root, the excitation's sine and cosine by fdlibm's kernels, inlined, the band's sin² as a polynomial, no powf for "
               "α = 4/3); no allocation on the stepping path (each DOPRI5 step written in place); the stages form "
               "only ξ and ξ' (the energy quadratures advance at the step's end); the first step into a piece "
-              "starts from what the earlier entries into it taught the step-size controller (`entries`: the "
-              "first step into a band was rejected at half of the entries before); the step-size controller's "
+              "starts from what the earlier entries into it taught the step-size controller (`entries`); the step-size controller's "
               "powers by a coarse log2/exp2; the free flight's start computed once per passage; outputs computed "
               "only when read. What is left, with the most each could give here (the share it could remove, as "
               "a speed-up bound):")
@@ -340,11 +339,11 @@ def analysis(rows, s1, r_rust, n_rust, r_user, n_user, r_py, n_py, comm_rows, to
                   "take fewer steps inside the contacts and bands, where the steps now are (MODEL.md: higher orders "
                   "did not pay, each band crossing costs 2-3 steps whatever the order): a step that follows the "
                   "contact's own oscillation, e.g. a linearised contact step, is the lever not yet tried. Tried and "
-                  "dropped: crossing an edge at the straddling step's dense output instead of redoing the step "
-                  "(10 % fewer RHS at rtol 1e-6, but in the stress suite (make stability) S1's error grew 2.6×, "
-                  "ε = 0's 32×, ε = 1e-9's 190× and the energy balance's 7×: three cases failed); aiming each step that would cross an edge to "
-                  "end just past it and crossing at its dense output (5 % fewer RHS, CPU unchanged within the "
-                  "A/B's noise).")
+                  "dropped (code not kept; its figures are in issue 3's closing note of session 4): crossing an "
+                  "edge at the straddling step's dense output instead of redoing the step (fewer RHS, but three "
+                  "cases of the stress suite, make stability, failed, among them ε = 0 and the energy balance); "
+                  "aiming each step that would cross an edge to end just past it and crossing at its dense output "
+                  "(fewer RHS, CPU unchanged within the A/B's noise).")
                 a("")
     if comm_rows:
         key = [cr for cr in comm_rows if tol_1e9 and math.isclose(cr[0], tol_1e9)] or comm_rows[:1]

@@ -7,8 +7,9 @@
 //! gear-rattle benchmark (S1) they took 25 % and 15 % of the profile samples. Measured on S1
 //! (1 s, rtol 1e-7, GearRattle alone, builds alternated 8 times): the run's median CPU time
 //! fell by about a fifth with the cube root below, then by 7 % more with the sine and cosine.
-//! The band's single `sin` stays glibc's: it lies on the critical path, where glibc's FMA
-//! variant beats a kernel compiled for baseline x86-64 (tried: 1 % slower, dropped).
+//! The band's smoothing sin² is a polynomial on its argument's range ([`sin_squared`]): a
+//! general sine kernel compiled for baseline x86-64 had been 1 % slower there than glibc's
+//! FMA variant (dropped).
 
 /// Bits of the mantissa that index the tables of `cbrt`.
 const TABLE_BITS: u32 = 8;
@@ -207,8 +208,9 @@ const SIN_SQUARED: [f64; 13] = {
 };
 
 /// sin² x for |x| ≤ π/2: the smoothing factor of the contact bands (MODEL.md §2), to
-/// 6e-16 absolute, under 3 ulp of 1 (test `sin_squared_matches_std`, measured 5.6e-16). x² times the Taylor series of
-/// (sin x / x)² to u^12 (u = x², truncation below 2e-16 at π/2), summed by Estrin's scheme.
+/// 6e-16 absolute, under 3 ulp of 1 (test `sin_squared_matches_std`, measured 5.6e-16).
+/// x² times the Taylor series of (sin x / x)² to u^12 (u = x², truncation below 2e-16 at
+/// π/2), summed by Estrin's scheme.
 ///
 /// Why not `f64::sin`: the band's factor lies on the critical path of every band RHS (the
 /// next stage waits for it), and glibc's sin, with its argument reduction and branches, was

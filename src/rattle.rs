@@ -125,8 +125,17 @@ pub(crate) fn cross_edge(
 impl System<N> for Rattle {
     #[inline]
     fn rhs(&self, t: f64, y: &State) -> State {
+        self.rhs_in(self.region, t, y)
+    }
+}
+
+impl Rattle {
+    /// The right-hand side with the formula of `region` (the benchmark's peers keep the
+    /// region apart, where their crates' closures can follow it).
+    #[inline]
+    pub fn rhs_in(&self, region: Region, t: f64, y: &State) -> State {
         let shaft = self.excitation.at(t);
-        let loads = self.dynamics.loads(self.region, y[XI], y[XI_DOT], &shaft);
+        let loads = self.dynamics.loads(region, y[XI], y[XI_DOT], &shaft);
         let p = &self.dynamics.params;
         let [e_contact, e_lubricant, w_shaft] = power_flows(p, &loads, y[XI_DOT], shaft.omega);
         [y[XI_DOT], loads.xi_ddot, e_contact, e_lubricant, w_shaft]

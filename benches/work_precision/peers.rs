@@ -32,7 +32,7 @@
 
 use std::cell::Cell;
 
-use gear_rattle::integrator::{Edge, Piecewise, System};
+use gear_rattle::integrator::{Edge, Piecewise};
 use gear_rattle::physics::{Dynamics, Excitation, GearParams, Region};
 use gear_rattle::rattle::{N, Rattle, State, XI, XI_DOT};
 
@@ -96,7 +96,7 @@ impl UserRhs {
 /// The gear pair's right-hand side with the region read from a cell, so that a crate's
 /// closure or trait object can follow region changes made by the driver. Counts evaluations.
 pub struct Model {
-    /// The gear pair; its region is the cell's.
+    /// The gear pair; its own region is not used (the cell's is).
     pub rattle: Rattle,
     pub region: Cell<Region>,
     pub evals: Cell<u64>,
@@ -122,9 +122,7 @@ impl Model {
         if let Some(user) = &self.user {
             return user.rhs(t, y);
         }
-        let mut rattle = self.rattle;
-        rattle.region = self.region.get();
-        rattle.rhs(t, y)
+        self.rattle.rhs_in(self.region.get(), t, y)
     }
 }
 

@@ -262,16 +262,7 @@ fn call_split(import: &Fmi2Import, sc: &Scene, rtol: f64, integration: f64) {
         let mut inst = import
             .instantiate_cs("split", false, false)
             .expect("instantiate");
-        inst.setup_experiment(Some(rtol), 0.0, None).expect("setup");
-        inst.enter_initialization_mode().expect("init");
-        inst.set_integer(&[vr::excitation], &[1])
-            .expect("excitation");
-        inst.set_real(
-            &[vr::A_rms, vr::f_exc, vr::I_L, vr::C_LM],
-            &[sc.A_rms, sc.f_exc, sc.I_L, sc.C_LM],
-        )
-        .expect("parameters");
-        inst.exit_initialization_mode().expect("init");
+        init_fmu(&mut inst, sc, rtol).expect("initialisation");
         let mut x = [0.0; 2];
         let start = cpu_now();
         for _ in 0..CALLS {

@@ -53,6 +53,17 @@ pub struct Instance {
     pub messages: Vec<Message>,
 }
 
+/// Why fmi2DoStep refuses a step ([`Instance::check_step`]).
+#[derive(Clone, Copy, Debug)]
+enum StepRefusal {
+    /// h not finite and > 0.
+    Size,
+    /// The communication point is not the instance's time.
+    Time,
+    /// t + h − t misses h by more than 0.1 % (the value it has).
+    Resolution(f64),
+}
+
 impl Instance {
     pub fn new(logging_on: bool) -> Self {
         let mut logging = [logging_on; LOG_CATEGORIES.len()];
@@ -442,8 +453,8 @@ impl Instance {
 
     pub fn do_step(&mut self, current: f64, h: f64) -> FmiResult {
         let sim = self.sim.as_mut().expect("initialised");
-        if !Self::step_is_valid(current, h, sim.t) {
-            return Err(Self::step_refused(current, h, sim.t));
+        if let Err(why) = Self::check_step(current, h, sim.t) {
+            return Err(Self::step_refused(why, current, h, sim.t));
         }
         sim.t = current;
         let t_end = current + h;
@@ -475,31 +486,34 @@ impl Instance {
     /// t = 1e9 s the spacing of doubles is 1.2e-7 s), and is refused rather than stretched or
     /// shrunk.
     #[inline]
-    fn step_is_valid(current: f64, h: f64, t: f64) -> bool {
-        let drift = (current - t).abs();
+    fn check_step(current: f64, h: f64, t: f64) -> Result<(), StepRefusal> {
+        if !(h > 0.0 && h.is_finite()) {
+            return Err(StepRefusal::Size);
+        }
+        if !current.is_finite() || (current - t).abs() > 1e-9 * t.abs().max(h).max(1e-3) {
+            return Err(StepRefusal::Time);
+        }
         let resolved = (current + h) - current;
-        h > 0.0
-            && h.is_finite()
-            && current.is_finite()
-            && drift <= 1e-9 * t.abs().max(h).max(1e-3)
-            && (resolved - h).abs() <= 1e-3 * h
+        if (resolved - h).abs() > 1e-3 * h {
+            return Err(StepRefusal::Resolution(resolved));
+        }
+        Ok(())
     }
 
-    /// Why [`Instance::step_is_valid`] refused a step (kept off the path of a valid one).
+    /// The message of a refused step (kept off the path of a valid one).
     #[cold]
     #[inline(never)]
-    fn step_refused(current: f64, h: f64, t: f64) -> FmiError {
-        FmiError::error(if !(h > 0.0 && h.is_finite()) {
-            format!(
+    fn step_refused(why: StepRefusal, current: f64, h: f64, t: f64) -> FmiError {
+        FmiError::error(match why {
+            StepRefusal::Size => format!(
                 "communicationStepSize = {h:e} at t = {current} refused: it must be finite and > 0"
-            )
-        } else if !current.is_finite() || (current - t).abs() > 1e-9 * t.abs().max(h).max(1e-3) {
-            format!("currentCommunicationPoint = {current} does not match the instance's time {t}")
-        } else {
-            format!(
-                "communicationStepSize = {h:e} at t = {current} is below the resolution of time there (t + h - t = {:e} s): refused",
-                (current + h) - current
-            )
+            ),
+            StepRefusal::Time => format!(
+                "currentCommunicationPoint = {current} does not match the instance's time {t}"
+            ),
+            StepRefusal::Resolution(resolved) => format!(
+                "communicationStepSize = {h:e} at t = {current} is below the resolution of time there (t + h - t = {resolved:e} s): refused"
+            ),
         })
     }
 

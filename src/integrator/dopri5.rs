@@ -88,9 +88,9 @@ fn combine<const N: usize>(y: &[f64; N], h: f64, terms: &[(f64, &[f64; N])], m: 
 /// a run on S1).
 ///
 /// Components `dynamic..N` are quadratures (∫ of a rate, like a dissipated energy) that
-/// the right-hand side does not read: the stages' arguments and the error estimate
-/// form only components `0..dynamic`; the quadratures advance with the 5th-order weights (on S1,
-/// three of the five components: measured −4 % CPU per run).
+/// the right-hand side does not read: the stages' arguments and the error estimate form only
+/// components `0..dynamic`; the quadratures advance with the 5th-order weights (three of the
+/// gear's five components).
 pub fn step<S: System<N>, const N: usize>(
     sys: &S,
     t: f64,

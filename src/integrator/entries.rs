@@ -1,8 +1,9 @@
 //! The first DOPRI5 step into a piece after an edge. The step size carried over the edge is
 //! the one the old piece allowed, which can be far from what the new one allows: on the
-//! gear's bench scene S1 (rtol 1e-6), the first step into a smoothing band was rejected at
-//! more than half the entries (its error estimate a median 1.3 times the tolerance), and the
-//! first step into a contact was accepted at 1/150 of it, so 2x too short. A piece is
+//! gear's bench scene S1 (rtol 1e-6), the first step into a smoothing band was often
+//! rejected and the first step into a contact accepted far below the tolerance (its
+//! controller then doubled it); the run's rejected steps fell from 1 056 to 568 with what
+//! follows (`BENCH_PROFILE=1` of the work-precision bench, before and after). A piece is
 //! entered the same way again and again (a rattling gear enters each band from the gap and
 //! from the contact at every impact), so the solver remembers, per piece and per edge it was
 //! entered through, the ratio of the step size its controller wanted there to the one carried
@@ -44,8 +45,11 @@ pub(super) struct Entries {
 impl Entries {
     /// The factor to apply to the step size carried into `entry` (1 for a new one).
     pub fn ratio(&self, entry: &Entry) -> f64 {
-        self.find(entry)
-            .map_or(1.0, |i| self.slots[i].map_or(1.0, |s| s.log_ratio.exp()))
+        self.slots
+            .iter()
+            .flatten()
+            .find(|s| s.entry == *entry)
+            .map_or(1.0, |s| s.log_ratio.exp())
     }
 
     /// The controller, having judged the first step into `entry`, wants `wanted` where
@@ -55,12 +59,8 @@ impl Entries {
         if !observed.is_finite() {
             return;
         }
-        match self.find(entry) {
-            Some(i) => {
-                if let Some(slot) = &mut self.slots[i] {
-                    slot.log_ratio = 0.5 * (slot.log_ratio + observed);
-                }
-            }
+        match self.slots.iter_mut().flatten().find(|s| s.entry == *entry) {
+            Some(slot) => slot.log_ratio = 0.5 * (slot.log_ratio + observed),
             None => {
                 self.slots[self.next] = Some(Slot {
                     entry: *entry,
@@ -69,12 +69,6 @@ impl Entries {
                 self.next = (self.next + 1) % SLOTS;
             }
         }
-    }
-
-    fn find(&self, entry: &Entry) -> Option<usize> {
-        self.slots
-            .iter()
-            .position(|s| s.is_some_and(|s| s.entry == *entry))
     }
 }
 

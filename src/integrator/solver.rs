@@ -412,8 +412,8 @@ impl<const N: usize> Solver<N> {
                         return Err(SolverError::Chattering { t: *t });
                     }
                 }
-                self.h = step.h_next.max(theta * h);
                 self.cross(sys, edge, *t, y);
+                self.h = step.h_next.max(theta * h);
                 continue;
             }
             crossings_here = 0;

@@ -44,11 +44,10 @@ impl Sine {
     }
 }
 
-/// The main shaft over an interval [t0, t1]: its speeds at both ends and the angle turned,
-/// computed as a difference of motion, not of two large angles.
+/// The main shaft over an interval [t0, t1] (its start in [`SpanStart`]): its speed at t1 and
+/// the angle turned, computed as a difference of motion, not of two large angles.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Span {
-    pub omega0: f64,
     pub omega1: f64,
     /// θ_M(t1) − θ_M(t0) [rad].
     pub angle: f64,
@@ -56,7 +55,7 @@ pub struct Span {
 
 /// What every span from t0 shares: the shaft's speed there and, for the sine, sin(w t0).
 /// Computed once for the many spans of a free flight ([`Excitation::span_from`]).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct SpanStart {
     pub t0: f64,
     pub omega0: f64,
@@ -80,7 +79,6 @@ impl Sine {
         let (s1, c1) = crate::math::sin_cos(self.w * t1);
         let a_over_w = self.amplitude / self.w;
         Span {
-            omega0: start.omega0,
             omega1: self.omega_mean - a_over_w * c1,
             angle: self.omega_mean * (t1 - start.t0) - a_over_w / self.w * (s1 - start.sin0),
         }
@@ -141,11 +139,6 @@ impl Excitation {
         }
     }
 
-    /// The shaft over [t0, t1] (see [`Span`]).
-    pub fn span(&self, t0: f64, t1: f64) -> Span {
-        self.span_from(&self.span_start(t0), t1)
-    }
-
     /// What the spans from t0 share (see [`SpanStart`]).
     pub fn span_start(&self, t0: f64) -> SpanStart {
         match self {
@@ -166,7 +159,6 @@ impl Excitation {
                 let (a, b) = (start.t0 - p.t0, t1 - p.t0);
                 let s = &p.at_t0;
                 Span {
-                    omega0: start.omega0,
                     omega1: s.omega + b * s.alpha,
                     angle: (b - a) * (s.omega + 0.5 * s.alpha * (a + b)),
                 }
@@ -215,10 +207,11 @@ mod tests {
         });
         for e in [sine, poly] {
             let (t0, t1) = (0.2031, 0.2107);
-            let span = e.span(t0, t1);
+            let start = e.span_start(t0);
+            let span = e.span_from(&start, t1);
             let diff = e.at(t1).theta - e.at(t0).theta;
             assert!((span.angle - diff).abs() < 1e-13, "{e:?}");
-            assert_eq!(span.omega0, e.at(t0).omega);
+            assert_eq!(start.omega0, e.at(t0).omega);
             assert_eq!(span.omega1, e.at(t1).omega);
         }
     }

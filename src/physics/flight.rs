@@ -27,10 +27,10 @@ pub struct FlightState {
 /// What every point of a free flight from (t0, ξ0, ξ'0) shares: the start, the shaft there
 /// (one sine and cosine) and u0 = ω_L(t0) − ω_S. Plain data, kept along a passage through
 /// the gap so that each point costs only its own end ([`Flight::at`]).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct FlightStart {
-    pub xi0: f64,
-    pub xi_dot0: f64,
+    xi0: f64,
+    xi_dot0: f64,
     shaft: SpanStart,
     u0: f64,
 }

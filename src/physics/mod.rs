@@ -1,7 +1,8 @@
 //! The physics of the gear pair, as restated in `shared/MODEL.md`: parameters (§4), the
 //! contact law (§2), the equation of motion written for the transmission error ξ (§1, §3)
 //! and the excitation of the main shaft (§5), imposed or, in torque mode, an inertia driven
-//! by a torque (motion.rs); the free flight in the gap in closed form (flight.rs). Knows nothing of integrators or FMI.
+//! by a torque (motion.rs); the free flight in the gap in closed form (flight.rs). Knows
+//! nothing of integrators or FMI.
 
 pub mod contact;
 pub mod excitation;
@@ -10,7 +11,7 @@ pub mod motion;
 pub mod params;
 
 pub use contact::{ContactLaw, ForceSlopes, Region};
-pub use excitation::{Excitation, Polynomial, Shaft, Sine, Span, TorqueRamp};
-pub use flight::{Flight, FlightStart, FlightState};
+pub use excitation::{Excitation, Polynomial, Shaft, Sine, TorqueRamp};
+pub use flight::{Flight, FlightStart};
 pub use motion::{Dynamics, Loads, MainShaft};
 pub use params::{GearParams, ParamError};
