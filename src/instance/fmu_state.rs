@@ -11,7 +11,7 @@ use serde::{Deserialize, Serialize};
 
 const MAGIC: &[u8; 4] = b"GRFS";
 /// 3: the gear pair keeps the start of the free flight it passes through.
-const VERSION: u16 = 3;
+const VERSION: u16 = 4;
 const HEADER: usize = 4 + 2 + 4;
 const TRAILER: usize = 4;
 

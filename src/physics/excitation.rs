@@ -20,14 +20,21 @@ pub struct Sine {
     amplitude: f64,
     w: f64,
     omega_mean: f64,
+    /// A/w and A/w², the amplitudes of ω_M and θ_M, divided once here rather than at every
+    /// right-hand side and every point of a free flight.
+    a_over_w: f64,
+    a_over_w2: f64,
 }
 
 impl Sine {
     pub fn new(a_rms: f64, f_exc: f64, omega_mean: f64) -> Self {
+        let (amplitude, w) = (SQRT_2 * a_rms, 2.0 * PI * f_exc);
         Sine {
-            amplitude: SQRT_2 * a_rms,
-            w: 2.0 * PI * f_exc,
+            amplitude,
+            w,
             omega_mean,
+            a_over_w: amplitude / w,
+            a_over_w2: amplitude / w / w,
         }
     }
 
@@ -35,10 +42,9 @@ impl Sine {
     #[inline]
     pub fn at(&self, t: f64) -> Shaft {
         let (sin, cos) = crate::math::sin_cos(self.w * t);
-        let a_over_w = self.amplitude / self.w;
         Shaft {
-            theta: self.omega_mean * t - a_over_w / self.w * sin,
-            omega: self.omega_mean - a_over_w * cos,
+            theta: self.omega_mean * t - self.a_over_w2 * sin,
+            omega: self.omega_mean - self.a_over_w * cos,
             alpha: self.amplitude * sin,
         }
     }
@@ -68,7 +74,7 @@ impl Sine {
         let (sin0, cos0) = crate::math::sin_cos(self.w * t0);
         SpanStart {
             t0,
-            omega0: self.omega_mean - self.amplitude / self.w * cos0,
+            omega0: self.omega_mean - self.a_over_w * cos0,
             sin0,
         }
     }
@@ -77,10 +83,9 @@ impl Sine {
     /// and cosine.
     fn span_from(&self, start: &SpanStart, t1: f64) -> Span {
         let (s1, c1) = crate::math::sin_cos(self.w * t1);
-        let a_over_w = self.amplitude / self.w;
         Span {
-            omega1: self.omega_mean - a_over_w * c1,
-            angle: self.omega_mean * (t1 - start.t0) - a_over_w / self.w * (s1 - start.sin0),
+            omega1: self.omega_mean - self.a_over_w * c1,
+            angle: self.omega_mean * (t1 - start.t0) - self.a_over_w2 * (s1 - start.sin0),
         }
     }
 }

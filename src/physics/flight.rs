@@ -25,14 +25,21 @@ pub struct FlightState {
 }
 
 /// What every point of a free flight from (t0, ξ0, ξ'0) shares: the start, the shaft there
-/// (one sine and cosine) and u0 = ω_L(t0) − ω_S. Plain data, kept along a passage through
-/// the gap so that each point costs only its own end ([`Flight::at`]).
+/// (one sine and cosine), u0 = ω_L(t0) − ω_S, and the drag's constants λ, 1/λ and
+/// u∞ = B/C. Plain data, kept along a passage through the gap so that each point costs only
+/// its own end ([`Flight::at`]), with no division.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct FlightStart {
     xi0: f64,
     xi_dot0: f64,
     shaft: SpanStart,
     u0: f64,
+    /// λ = C/I_L [1/s].
+    lambda: f64,
+    /// 1/λ, infinite when C = 0 (then unused).
+    inv_lambda: f64,
+    /// u∞ = B/C, the speed the drag settles u to (0 when C = 0, then unused).
+    u_inf: f64,
 }
 
 impl FlightStart {
@@ -70,6 +77,9 @@ impl<'a> Flight<'a> {
                 xi_dot0,
                 shaft,
                 u0,
+                lambda: params.C / params.I_L,
+                inv_lambda: params.I_L / params.C,
+                u_inf: if params.C == 0.0 { 0.0 } else { params.B / params.C },
             },
         }
     }
@@ -78,14 +88,20 @@ impl<'a> Flight<'a> {
     /// sine and cosine) per call.
     pub fn at(&self, t: f64) -> FlightState {
         let p = self.params;
-        let FlightStart { xi0, shaft, u0, .. } = self.start;
+        let FlightStart {
+            xi0,
+            shaft,
+            u0,
+            lambda,
+            inv_lambda,
+            ..
+        } = self.start;
         let span = self.excitation.span_from(&shaft, t);
-        let lambda = p.C / p.I_L;
         let tau = t - shaft.t0;
         let x = lambda * tau;
-        // e^(−x) − 1, exact to the last digits for small x; φ1 = τ (1 − e^(−x))/x.
+        // e^(−x) − 1, exact to the last digits for small x; φ1 = (1 − e^(−x))/λ, τ if C = 0.
         let em1 = (-x).exp_m1();
-        let phi1 = if x == 0.0 { tau } else { -em1 / lambda };
+        let phi1 = if p.C == 0.0 { tau } else { -em1 * inv_lambda };
         let mut u = u0 * (1.0 + em1);
         let mut turned_L = p.omega_S * tau + u0 * phi1;
         if p.B != 0.0 {
@@ -96,26 +112,21 @@ impl<'a> Flight<'a> {
         FlightState {
             xi: xi0 + (p.r_L * turned_L - p.r_M * span.angle),
             xi_dot: p.r_L * (p.omega_S + u) - p.r_M * span.omega1,
-            e_lubricant: self.dissipated(u0, tau, x, em1),
+            e_lubricant: self.dissipated(tau, phi1, em1),
         }
     }
 
-    /// ∫0^τ C u² ds: with u = c + a e^(−λs), c = B/C, a = u0 − c,
-    /// C (c² τ + 2 c a φ1(λ) + a² φ1(2λ)), where φ1(2λ) = τ (1 − e^(−2x))/(2x) and
-    /// 1 − e^(−2x) = −em1 (2 + em1); nothing when C = 0.
-    fn dissipated(&self, u0: f64, tau: f64, x: f64, em1: f64) -> f64 {
+    /// ∫0^τ C u² ds: with u = u∞ + a e^(−λs), a = u0 − u∞,
+    /// C (u∞² τ + 2 u∞ a φ1 + a² (1 − e^(−2λτ))/(2λ)), where (1 − e^(−2λτ))/(2λ) =
+    /// φ1 (1 + em1/2) since 1 − e^(−2x) = −em1 (2 + em1); nothing when C = 0.
+    fn dissipated(&self, tau: f64, phi1: f64, em1: f64) -> f64 {
         let p = self.params;
         if p.C == 0.0 {
             return 0.0;
         }
-        let c = p.B / p.C;
-        let a = u0 - c;
-        let (phi1, phi1_double) = if x == 0.0 {
-            (1.0, 1.0)
-        } else {
-            (-em1 / x, -em1 * (2.0 + em1) / (2.0 * x))
-        };
-        p.C * tau * (c * c + 2.0 * c * a * phi1 + a * a * phi1_double)
+        let FlightStart { u0, u_inf, .. } = self.start;
+        let a = u0 - u_inf;
+        p.C * (u_inf * (u_inf * tau + 2.0 * a * phi1) + a * a * phi1 * (1.0 + 0.5 * em1))
     }
 
     /// A bound on |ξ''| over the whole flight from t0 on: r_L |ω_L'(t0)| + r_M max |a_M|
