@@ -59,6 +59,10 @@ impl MainShaft {
 pub struct Dynamics {
     pub params: GearParams,
     pub law: ContactLaw,
+    /// 1/r_L and 1/I_L: the right-hand side multiplies by them (two divisions, one waiting
+    /// for the other, were on the path of every stage).
+    inv_r_L: f64,
+    inv_I_L: f64,
 }
 
 impl Dynamics {
@@ -66,6 +70,8 @@ impl Dynamics {
         Dynamics {
             law: ContactLaw::new(&params),
             params,
+            inv_r_L: 1.0 / params.r_L,
+            inv_I_L: 1.0 / params.I_L,
         }
     }
 
@@ -104,8 +110,8 @@ impl Dynamics {
     #[inline]
     fn respond(&self, force: ContactForce, xi_dot: f64, shaft: &Shaft) -> Loads {
         let p = &self.params;
-        let omega_L = (xi_dot + p.r_M * shaft.omega) / p.r_L;
-        let alpha_L = (p.B - p.r_L * force.total() - p.C * (omega_L - p.omega_S)) / p.I_L;
+        let omega_L = (xi_dot + p.r_M * shaft.omega) * self.inv_r_L;
+        let alpha_L = (p.B - p.r_L * force.total() - p.C * (omega_L - p.omega_S)) * self.inv_I_L;
         Loads {
             force,
             omega_L,
