@@ -120,8 +120,9 @@ const REDUCTION_LIMIT: f64 = 1_647_099.0; // ≈ 2^20 · π/2
 /// absolute (half an ulp of 1), and within 2 ulp of std's where |sin| or |cos| > 2^-10.
 #[inline]
 pub fn sin_cos(x: f64) -> (f64, f64) {
-    if !(x.abs() <= REDUCTION_LIMIT) {
-        return x.sin_cos(); // large or not finite
+    // Large or not finite (NaN fails every comparison): the standard library's.
+    if x.is_nan() || x.abs() > REDUCTION_LIMIT {
+        return x.sin_cos();
     }
     let (n, r, y) = reduce(x);
     let (s, c) = (kernel_sin(r, y), kernel_cos(r, y));
@@ -137,12 +138,12 @@ pub fn sin_cos(x: f64) -> (f64, f64) {
 /// |x| ≤ REDUCTION_LIMIT.
 #[inline]
 fn reduce(x: f64) -> (i64, f64, f64) {
-    const INV_PIO2: f64 = 6.366_197_723_675_813_824_33e-1;
+    const INV_PIO2: f64 = std::f64::consts::FRAC_2_PI;
     // π/2 in parts of 33 bits: PIO2_1 + PIO2_2 + PIO2_3 + PIO2_3T.
-    const PIO2_1: f64 = 1.570_796_326_734_125_614_17;
-    const PIO2_2: f64 = 6.077_100_506_303_965_976_60e-11;
-    const PIO2_3: f64 = 2.022_266_248_711_166_455_80e-21;
-    const PIO2_3T: f64 = 8.478_427_660_368_899_569_97e-32;
+    const PIO2_1: f64 = 1.570_796_326_734_125_6;
+    const PIO2_2: f64 = 6.077_100_506_303_966e-11;
+    const PIO2_3: f64 = 2.022_266_248_711_166_5e-21;
+    const PIO2_3T: f64 = 8.478_427_660_368_9e-32;
     // Round to nearest by adding and removing 1.5·2^52 (|x·2/π| < 2^51): `f64::round` is a
     // library call on the baseline x86-64 target, which has no rounding instruction.
     const TOINT: f64 = 6_755_399_441_055_744.0;
@@ -160,12 +161,12 @@ fn reduce(x: f64) -> (i64, f64, f64) {
 /// sin(x + y) for |x| ≤ π/4, y a correction below ulp(x) (fdlibm's __kernel_sin).
 #[inline]
 fn kernel_sin(x: f64, y: f64) -> f64 {
-    const S1: f64 = -1.666_666_666_666_663_243_48e-01;
-    const S2: f64 = 8.333_333_333_322_489_461_24e-03;
-    const S3: f64 = -1.984_126_982_985_794_931_34e-04;
-    const S4: f64 = 2.755_731_370_707_006_767_89e-06;
-    const S5: f64 = -2.505_076_025_340_686_341_95e-08;
-    const S6: f64 = 1.589_690_995_211_550_102_21e-10;
+    const S1: f64 = -1.666_666_666_666_663_2e-1;
+    const S2: f64 = 8.333_333_333_322_49e-3;
+    const S3: f64 = -1.984_126_982_985_795e-4;
+    const S4: f64 = 2.755_731_370_707_006_8e-6;
+    const S5: f64 = -2.505_076_025_340_686_3e-8;
+    const S6: f64 = 1.589_690_995_211_55e-10;
     let z = x * x;
     let v = z * x;
     let r = S2 + z * (S3 + z * (S4 + z * (S5 + z * S6)));
@@ -175,12 +176,12 @@ fn kernel_sin(x: f64, y: f64) -> f64 {
 /// cos(x + y) for |x| ≤ π/4, y a correction below ulp(x) (fdlibm's __kernel_cos).
 #[inline]
 fn kernel_cos(x: f64, y: f64) -> f64 {
-    const C1: f64 = 4.166_666_666_666_660_190_37e-02;
-    const C2: f64 = -1.388_888_888_887_410_957_49e-03;
-    const C3: f64 = 2.480_158_728_947_672_941_78e-05;
-    const C4: f64 = -2.755_731_435_139_066_330_35e-07;
-    const C5: f64 = 2.087_572_321_298_174_827_90e-09;
-    const C6: f64 = -1.135_964_755_778_819_482_65e-11;
+    const C1: f64 = 4.166_666_666_666_66e-2;
+    const C2: f64 = -1.388_888_888_887_411e-3;
+    const C3: f64 = 2.480_158_728_947_673e-5;
+    const C4: f64 = -2.755_731_435_139_066_3e-7;
+    const C5: f64 = 2.087_572_321_298_175e-9;
+    const C6: f64 = -1.135_964_755_778_819_5e-11;
     let z = x * x;
     let w = z * z;
     let r = z * (C1 + z * (C2 + z * C3)) + w * w * (C4 + z * (C5 + z * C6));
