@@ -12,6 +12,9 @@
 //! Environment: BENCH_QUICK=1 (one scene, three tolerances, one repeat: a smoke run),
 //! BENCH_SCENES=S1-1s,S2-0.2s (a subset), BENCH_BUDGET=seconds of CPU per group of
 //! interleaved configurations (default 1.5), BENCH_OUT=path of the CSV.
+//! BENCH_DEBUG=gr|dopri5|dop853|tsit45 with BENCH_DEBUG_RTOL=r (and BENCH_DEBUG_SCENE, default
+//! S1-0.2s): one run, printed against the reference point by point (t, ξ, Δξ, impacts).
+//! BENCH_PROFILE=1 or calls: see `profile`.
 #![allow(non_snake_case)]
 
 #[path = "work_precision/peers.rs"]
@@ -653,7 +656,8 @@ fn main() {
     let ref_dir = root.join("target/bench/reference");
     if let Ok(which) = std::env::var("BENCH_DEBUG") {
         let scenes = load_scenes(&ref_dir);
-        let sc = scenes.iter().find(|s| s.name == "S1-0.2s").unwrap();
+        let name = std::env::var("BENCH_DEBUG_SCENE").unwrap_or_else(|_| "S1-0.2s".into());
+        let sc = scenes.iter().find(|s| s.name == name).expect("a scene of the reference");
         let r = load_reference(&ref_dir, &sc.base);
         let rtol: f64 = std::env::var("BENCH_DEBUG_RTOL").unwrap().parse().unwrap();
         let out = match which.as_str() {
