@@ -657,7 +657,10 @@ fn main() {
     if let Ok(which) = std::env::var("BENCH_DEBUG") {
         let scenes = load_scenes(&ref_dir);
         let name = std::env::var("BENCH_DEBUG_SCENE").unwrap_or_else(|_| "S1-0.2s".into());
-        let sc = scenes.iter().find(|s| s.name == name).expect("a scene of the reference");
+        let sc = scenes
+            .iter()
+            .find(|s| s.name == name)
+            .expect("a scene of the reference");
         let r = load_reference(&ref_dir, &sc.base);
         let rtol: f64 = std::env::var("BENCH_DEBUG_RTOL").unwrap().parse().unwrap();
         let out = match which.as_str() {

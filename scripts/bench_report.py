@@ -340,18 +340,15 @@ def analysis(rows, s1, r_rust, n_rust, r_user, n_user, r_py, n_py, comm_rows, to
                   "take fewer steps inside the contacts and bands, where the steps now are (MODEL.md: higher orders "
                   "did not pay, each band crossing costs 2-3 steps whatever the order): a step that follows the "
                   "contact's own oscillation, e.g. a linearised contact step, is the lever not yet tried. Tried and "
-                  "dropped (code not kept; its figures are in issue 3's closing note of session 4): crossing an "
+                  "dropped (code not kept; their figures are in issue 3's closing notes of sessions 4 and 5): crossing an "
                   "edge at the straddling step's dense output instead of redoing the step (fewer RHS, but three "
                   "cases of the stress suite, make stability, failed, among them ε = 0 and the energy balance); "
                   "aiming each step that would cross an edge to end just past it and crossing at its dense output "
-                  "(fewer RHS, CPU unchanged within the A/B's noise); in session 5, two rewritings meant to "
-                  "shorten the chain from one stage to the next: adding the newest stage last in each stage's "
-                  "sum (+6 % CPU, 8 of 10 alternations slower) and regrouping ξ'' so that the contact force "
-                  "enters by one multiply and one subtraction (−2 %, 9 of 14 alternations faster: within the "
-                  "noise); the stages' loops over a count of dynamic components fixed at compile time (a "
-                  "seventh less of a step's own cost with a trivial right-hand side, but S1 6 % slower, 0 of 10 "
-                  "alternations faster); and the step-size control on the error's mean square, without the "
-                  "square root and with the weights inverted off the path (−3 %, 7 of 10: within the noise).")
+                  "(fewer RHS, CPU unchanged within the A/B's noise); adding the newest stage last in each stage's "
+                  "sum (slower); regrouping ξ'' so that the contact force enters by one multiply and one "
+                  "subtraction, and the step-size control on the error's mean square without the square root "
+                  "(each a few per cent, within the noise); the stages' loops over a count of dynamic components "
+                  "fixed at compile time (slower on S1).")
                 a("")
     if comm_rows:
         key = [cr for cr in comm_rows if tol_1e9 and math.isclose(cr[0], tol_1e9)] or comm_rows[:1]

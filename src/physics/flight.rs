@@ -79,7 +79,11 @@ impl<'a> Flight<'a> {
                 u0,
                 lambda: params.C / params.I_L,
                 inv_lambda: params.I_L / params.C,
-                u_inf: if params.C == 0.0 { 0.0 } else { params.B / params.C },
+                u_inf: if params.C == 0.0 {
+                    0.0
+                } else {
+                    params.B / params.C
+                },
             },
         }
     }
