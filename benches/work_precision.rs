@@ -14,13 +14,15 @@
 //! interleaved configurations (default 1.5), BENCH_OUT=path of the CSV.
 //! BENCH_DEBUG=gr|dopri5|dop853|tsit45 with BENCH_DEBUG_RTOL=r (and BENCH_DEBUG_SCENE, default
 //! S1-0.2s): one run, printed against the reference point by point (t, ξ, Δξ, impacts).
-//! BENCH_PROFILE=1 or calls: see `profile`.
+//! BENCH_PROFILE=1 or calls: see `profile`. BENCH_TAYLOR=1: see `taylor`.
 #![allow(non_snake_case)]
 
 #[path = "work_precision/peers.rs"]
 mod peers;
 #[path = "work_precision/profile.rs"]
 mod profile;
+#[path = "work_precision/taylor.rs"]
+mod taylor;
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -516,10 +518,10 @@ fn measure(configs: Vec<Config>, budget: f64, max_reps: usize) -> Vec<Measured> 
     };
     for _ in 1..reps {
         for (c, m) in configs.iter_mut().zip(out.iter_mut()) {
-            if m.first.is_ok() {
-                if let Ok((_, cpu)) = (c.runner)() {
-                    m.cpu.push(cpu);
-                }
+            if m.first.is_ok()
+                && let Ok((_, cpu)) = (c.runner)()
+            {
+                m.cpu.push(cpu);
             }
         }
     }
@@ -679,6 +681,10 @@ fn main() {
                 out.0.run.counts[j]
             );
         }
+        return;
+    }
+    if std::env::var("BENCH_TAYLOR").is_ok_and(|v| v == "1") {
+        taylor::run();
         return;
     }
     if std::env::var("BENCH_PROFILE").is_ok_and(|v| v == "1") {

@@ -5,8 +5,8 @@ docs/BENCHMARKS.md (issue 3).
 
 Reads target/bench/rust.csv (cargo bench -p gear_rattle_bench --bench work_precision), target/bench/python.csv
 (scripts/bench_python.py), target/bench/reference/scenes.csv (scripts/bench_reference.py)
-and, when present, target/bench/profile.txt and target/bench/machine.txt (written by
-mk/bench.mk). Ratios, not absolute times, carry the claims.
+and, when present, target/bench/profile.txt, calls.txt, taylor.txt and machine.txt (written
+by mk/bench.mk). Ratios, not absolute times, carry the claims.
 """
 
 from __future__ import annotations
@@ -338,9 +338,12 @@ def analysis(rows, s1, r_rust, n_rust, r_user, n_user, r_py, n_py, comm_rows, to
                   "same RHS; it moves it against the peers as users write them, and it moves the absolute cost, "
                   "which is what a user sees. Against peers with the same RHS and the same edge handling, 3× would "
                   "take fewer steps inside the contacts and bands, where the steps now are (MODEL.md: higher orders "
-                  "did not pay, each band crossing costs 2-3 steps whatever the order): a step that follows the "
-                  "contact's own oscillation, e.g. a linearised contact step, is the lever not yet tried. Tried and "
-                  "dropped (code not kept; their figures are in issue 3's closing notes of sessions 4 and 5): crossing an "
+                  "did not pay, each band crossing costs 2-3 steps whatever the order). The lever left is a step "
+                  "that covers more of a contact at once: a Taylor-series step of high order inside the "
+                  "full-contact regions, where δ stays at least ε from the kink of δ^(4/3), so that its Taylor "
+                  "coefficients follow by the recurrence of a power; its polynomial is its own dense output, so an "
+                  "edge needs no redone step. " + taylor_lever() + "Tried and "
+                  "dropped (code not kept; their figures are in issue 3's closing notes of sessions 4 to 6): crossing an "
                   "edge at the straddling step's dense output instead of redoing the step (fewer RHS, but three "
                   "cases of the stress suite, make stability, failed, among them ε = 0 and the energy balance); "
                   "aiming each step that would cross an edge to end just past it and crossing at its dense output "
@@ -348,7 +351,10 @@ def analysis(rows, s1, r_rust, n_rust, r_user, n_user, r_py, n_py, comm_rows, to
                   "sum (slower); regrouping ξ'' so that the contact force enters by one multiply and one "
                   "subtraction, and the step-size control on the error's mean square without the square root "
                   "(each a few per cent, within the noise); the stages' loops over a count of dynamic components "
-                  "fixed at compile time (slower on S1).")
+                  "fixed at compile time (slower on S1); the excitation's sine and cosine at a step's stages "
+                  "rotated from those at the step's start, one sin_cos per step instead of six (CPU unchanged "
+                  "within the noise; likely because they do not depend on the state, so the processor computes them "
+                  "alongside the stages' chain of dependent operations rather than on it).")
                 a("")
     if comm_rows:
         key = [cr for cr in comm_rows if tol_1e9 and math.isclose(cr[0], tol_1e9)] or comm_rows[:1]
@@ -377,6 +383,32 @@ def analysis(rows, s1, r_rust, n_rust, r_user, n_user, r_py, n_py, comm_rows, to
           "the Rust one costs tens of nanoseconds, and solve_ivp restarts at every edge (a new first step each "
           "time). The ratio is dominated by the interpreter, not by the method.")
     return "\n".join(out)
+
+
+def taylor_lever() -> str:
+    """What `make bench-profile` measured of a Taylor step in the contacts (target/bench/taylor.txt)."""
+    path = BENCH / "taylor.txt"
+    if not path.is_file():
+        return "It is not measured in this run (target/bench/taylor.txt is missing). "
+    text = path.read_text()
+    ratios = [float(x) for x in re.findall(r"at the error of DOPRI5 rtol \S+: Taylor \S+ tol \S+, ([0-9.]+)× less CPU", text)]
+    steps = [int(x) for x in re.findall(r"Taylor P=\d+ tol \S+\s+(\d+) steps", text)]
+    rhs = [int(x) for x in re.findall(r"DOPRI5 rtol \S+\s+(\d+) RHS in contact", text)]
+    if not (ratios and steps and rhs):
+        return "Its measurement (target/bench/taylor.txt) could not be read. "
+    text = (f"Measured outside the solver (`BENCH_TAYLOR=1`, section below) on three contact visits of S1: "
+            f"{min(steps)}-{max(steps)} Taylor steps of order 10-14 per visit where DOPRI5 takes {min(rhs)}-{max(rhs)} "
+            f"RHS, and {min(ratios):.1f}-{max(ratios):.1f}× less CPU at equal error at the visit's exit. ")
+    prof = BENCH / "profile.txt"
+    regions = parse_profile(prof.read_text())["regions"] if prof.is_file() else {}
+    contact = sum(v["pct"] for k, v in regions.items() if k.startswith("contact")) / 100
+    if contact:
+        # The contacts' share of the CPU taken as their share of the RHS (the stepping around each RHS
+        # costs about the same in every region); the bands stay with DOPRI5.
+        gain = [1 / (1 - contact + contact / r) for r in (min(ratios), max(ratios))]
+        text += (f"The full contacts take {contact * 100:.0f} % of the RHS on S1 (profile above); with the bands "
+                 f"left to DOPRI5, S1 would run {gain[0]:.1f}-{gain[1]:.1f}× faster. ")
+    return text + "The step is not in the solver yet. "
 
 
 def calls_split() -> str:
@@ -595,7 +627,8 @@ def main() -> None:
     w("  3. `cargo bench -p gear_rattle_bench --bench work_precision` (target/bench/rust.csv; `BENCH_QUICK=1` for a smoke run, "
       "`BENCH_SCENES=S1-1s,...` for a subset);")
     w("  4. `.venv/bin/python scripts/bench_python.py` (target/bench/python.csv; `--scenes all` for every scene);")
-    w("  5. `perf record` of GearRattle alone on S1 (target/bench/profile.txt, when perf is available);")
+    w("  5. `perf record` of GearRattle alone on S1 (target/bench/profile.txt, when perf is available), the cost "
+      "of a call (calls.txt) and a Taylor step in the contacts (taylor.txt): `make bench-profile`;")
     w("  6. `.venv/bin/python scripts/bench_report.py` (this file and docs/work_precision.png).")
     w("")
 
@@ -769,6 +802,20 @@ def main() -> None:
         w("")
         w("```")
         w(prof.read_text().rstrip())
+        w("```")
+        w("")
+    taylor = BENCH / "taylor.txt"
+    if taylor.is_file():
+        w("## The lever left: a Taylor step inside the contacts")
+        w("")
+        w("One contact visit of S1 on flank F+ (full contact, from ξ = −ε inwards back to −ε) by GearRattle's DOPRI5 "
+          "and by a Taylor-series step of order P written in the benchmark (benches/work_precision/taylor.rs, not "
+          "in the solver), energies included (`BENCH_TAYLOR=1 cargo bench -p gear_rattle_bench --bench "
+          "work_precision`). DOPRI5 starts each visit from its initial step guess, where a run starts from what "
+          "earlier entries taught it; the Taylor code is not tuned.")
+        w("")
+        w("```")
+        w(taylor.read_text().rstrip())
         w("```")
         w("")
     failed = [r for r in rows if r["status"] not in ("ok",) and not r["status"].startswith("skipped")]

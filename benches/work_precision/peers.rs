@@ -260,7 +260,8 @@ fn land<S: Stepper>(
             return Ok((tc, y, steps));
         }
         let next = tc - miss / y[XI_DOT];
-        if !(next > tp) {
+        // Newton leaving the step backwards, or NaN: keep the last length.
+        if next.partial_cmp(&tp) != Some(std::cmp::Ordering::Greater) {
             return Ok((tc, y, steps));
         }
         tc = next;

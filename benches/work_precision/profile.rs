@@ -23,10 +23,26 @@ fn index(r: Region) -> usize {
     REGIONS.iter().position(|(x, _)| *x == r).expect("a region")
 }
 
-/// `Rattle` with its right-hand sides counted per region.
-struct Counted {
-    inner: Rattle,
-    evals: Cell<[u64; 5]>,
+/// `Rattle` with its right-hand sides counted per region, and the first edge it crossed.
+pub struct Counted {
+    pub inner: Rattle,
+    pub evals: Cell<[u64; 5]>,
+    pub first_cross: Option<(f64, State)>,
+}
+
+impl Counted {
+    pub fn new(inner: Rattle) -> Self {
+        Counted {
+            inner,
+            evals: Cell::new([0; 5]),
+            first_cross: None,
+        }
+    }
+
+    /// Right-hand sides evaluated in `region`.
+    pub fn evals_in(&self, region: Region) -> u64 {
+        self.evals.get()[index(region)]
+    }
 }
 
 impl System<N> for Counted {
@@ -52,6 +68,7 @@ impl Piecewise<N> for Counted {
         self.inner.piece()
     }
     fn cross(&mut self, edge: Edge, t: f64, y: &State) {
+        self.first_cross.get_or_insert((t, *y));
         self.inner.cross(edge, t, y)
     }
     fn has_exact(&self) -> bool {
@@ -117,10 +134,7 @@ pub fn run(scenes: &[Scene]) {
 
     // 2. The same run with its right-hand sides counted per region.
     let p = sc.params();
-    let mut sys = Counted {
-        inner: Rattle::new(Dynamics::new(p), excitation(sc), 0.5 * p.G),
-        evals: Cell::new([0; 5]),
-    };
+    let mut sys = Counted::new(Rattle::new(Dynamics::new(p), excitation(sc), 0.5 * p.G));
     let mut solver = Solver::new(sys.inner.tolerance(rtol));
     let (mut t, mut y) = (0.0, y0(&p));
     for tg in grid(sc.t_end) {
