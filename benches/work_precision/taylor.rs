@@ -38,6 +38,7 @@ type Exit = (f64, State);
 /// the coefficients up to k. The shaft's ω_M and a_M are those of the sine about t.
 struct Series<const P: usize> {
     xi: [f64; P],
+    xi_dot: [f64; P],
     /// F = F_k + F_c, and the rates of E_CONTACT, E_LUBRICANT and W_SHAFT.
     rates: [[f64; P]; 3],
 }
@@ -98,12 +99,18 @@ fn series<const P: usize>(p: &GearParams, sine: (f64, f64), t: f64, y: &State) -
     };
     Series {
         xi,
+        xi_dot,
         rates: [
             product(&xi_dot, &xi_dot, p.C_LM),
             product(&slip, &slip, p.C),
             product(&force, &omega_M, -p.r_M),
         ],
     }
+}
+
+/// Σ c_k τ^k.
+fn horner<const P: usize>(c: &[f64; P], tau: f64) -> f64 {
+    c.iter().rev().fold(0.0, |acc, &x| acc * tau + x)
 }
 
 /// The visit by Taylor steps of order P − 1 in ξ: each step as long as the last two terms
@@ -127,37 +134,23 @@ fn visit<const P: usize>(
             )
         };
         let h = 0.9 * length(P - 2).min(length(P - 1));
+        let motion = |tau: f64| (horner(&s.xi, tau), horner(&s.xi_dot, tau));
         let at = |tau: f64| -> State {
-            let horner = |c: &[f64; P]| c.iter().rev().fold(0.0, |acc, &x| acc * tau + x);
-            let derivative: [f64; P] = std::array::from_fn(|k| {
-                if k + 1 < P {
-                    (k + 1) as f64 * s.xi[k + 1]
-                } else {
-                    0.0
-                }
-            });
-            let integral = |c: &[f64; P]| {
-                tau * c
-                    .iter()
-                    .enumerate()
-                    .rev()
-                    .fold(0.0, |acc, (k, &x)| acc * tau + x / (k + 1) as f64)
-            };
             let mut out = y;
-            out[XI] = horner(&s.xi);
-            out[XI_DOT] = horner(&derivative);
-            out[E_CONTACT] += integral(&s.rates[0]);
-            out[E_LUBRICANT] += integral(&s.rates[1]);
-            out[W_SHAFT] += integral(&s.rates[2]);
+            (out[XI], out[XI_DOT]) = motion(tau);
+            for (i, rate) in [E_CONTACT, E_LUBRICANT, W_SHAFT].into_iter().zip(&s.rates) {
+                let integral: [f64; P] = std::array::from_fn(|k| rate[k] / (k + 1) as f64);
+                out[i] += tau * horner(&integral, tau);
+            }
             out
         };
-        let end = at(h);
-        if end[XI] > level && steps > 1 {
+        let (xi_end, _) = motion(h);
+        if xi_end > level && steps > 1 {
             // Newton from the secant's guess; the exit lies inside the step.
-            let mut tau = h * (level - y[XI]) / (end[XI] - y[XI]);
+            let mut tau = h * (level - y[XI]) / (xi_end - y[XI]);
             for _ in 0..50 {
-                let here = at(tau);
-                let dt = (here[XI] - level) / here[XI_DOT];
+                let (xi, xi_dot) = motion(tau);
+                let dt = (xi - level) / xi_dot;
                 tau -= dt;
                 if dt.abs() <= 1e-15 * h {
                     break;
@@ -165,8 +158,8 @@ fn visit<const P: usize>(
             }
             return ((t + tau, at(tau)), steps);
         }
+        y = at(h);
         t += h;
-        y = end;
     }
     unreachable!()
 }
