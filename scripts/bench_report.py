@@ -210,9 +210,10 @@ def parse_profile(text):
     m = re.search(r"rtol ([0-9.e+-]+): ([0-9.]+) ms CPU per run", text)
     if m:
         p["rtol"], p["ms"] = float(m.group(1)), float(m.group(2))
-    m = re.search(r"work: (\d+) RHS, (\d+) accepted \+ (\d+) rejected steps, (\d+) edges", text)
+    m = re.search(r"work: (\d+) RHS, (\d+) accepted \+ (\d+) rejected steps \((\d+) of them Taylor steps\), "
+                  r"(\d+) edges", text)
     if m:
-        p["rhs"], p["accepted"], p["rejected"], p["edges"] = map(int, m.groups())
+        p["rhs"], p["accepted"], p["rejected"], p["series"], p["edges"] = map(int, m.groups())
     m = re.search(r"free flight in closed form: (\d+) evaluations of the exact solution", text)
     if m:
         p["flight_evals"] = int(m.group(1))

@@ -9,8 +9,11 @@ pub mod torque;
 
 use serde::{Deserialize, Serialize};
 
+use crate::integrator::taylor::{Coefficients, TERMS};
 use crate::integrator::{Edge, Jacobian, Piecewise, System, Tolerance};
-use crate::physics::{Dynamics, Excitation, Flight, FlightStart, GearParams, Loads, Region, Shaft};
+use crate::physics::{
+    ContactSeries, Dynamics, Excitation, Flight, FlightStart, GearParams, Loads, Region, Shaft,
+};
 
 /// Components of the state vector.
 pub const XI: usize = 0;
@@ -247,8 +250,59 @@ contact_pieces!(
     },
     fn guard_acceleration_bound(&self, t0: f64, y0: &State) -> f64 {
         self.flight(t0, y0).acceleration_bound()
+    },
+    /// In full contact, entered through a band (ε > 0, so that δ stays away from the
+    /// force's kink): the series of [`ContactSeries`] and the power flows'.
+    fn series(&self, t: f64, y: &State, c: &mut Coefficients<N>) -> bool {
+        self.dynamics.params.epsilon > 0.0 && self.contact_series(t, y, c)
     }
 );
+
+/// The coefficient k of a series squared, Σ_{j ≤ k} a_j a_{k−j}, each pair once.
+fn square(a: &[f64], k: usize) -> f64 {
+    let half: f64 = (0..(k + 1) / 2).map(|j| a[j] * a[k - j]).sum();
+    let middle = if k % 2 == 0 { a[k / 2] * a[k / 2] } else { 0.0 };
+    2.0 * half + middle
+}
+
+impl Rattle {
+    /// Taylor coefficients of the state in full contact (see [`ContactSeries`]); the
+    /// quadratures' are those of their rates (`power_flows`) integrated term by term.
+    fn contact_series(&self, t: f64, y: &State, c: &mut Coefficients<N>) -> bool {
+        let Some(s) = ContactSeries::<{ TERMS + 1 }>::new(
+            &self.dynamics,
+            &self.excitation,
+            self.region,
+            t,
+            y[XI],
+            y[XI_DOT],
+        ) else {
+            return false;
+        };
+        let p = &self.dynamics.params;
+        let xi_dot: [f64; TERMS] = std::array::from_fn(|k| (k + 1) as f64 * s.xi[k + 1]);
+        let slip: [f64; TERMS] = std::array::from_fn(|k| {
+            (xi_dot[k] + p.r_M * s.omega_M[k]) * (1.0 / p.r_L)
+                - if k == 0 { p.omega_S } else { 0.0 }
+        });
+        for k in 0..TERMS {
+            c[k][XI] = s.xi[k];
+            c[k][XI_DOT] = xi_dot[k];
+        }
+        c[0][E_CONTACT] = y[E_CONTACT];
+        c[0][E_LUBRICANT] = y[E_LUBRICANT];
+        c[0][W_SHAFT] = y[W_SHAFT];
+        for k in 1..TERMS {
+            // The coefficient k − 1 of each rate, integrated: / k.
+            let inv_k = 1.0 / k as f64;
+            c[k][E_CONTACT] = p.C_LM * square(&xi_dot, k - 1) * inv_k;
+            c[k][E_LUBRICANT] = p.C * square(&slip, k - 1) * inv_k;
+            let force_omega: f64 = (0..k).map(|j| s.force[j] * s.omega_M[k - 1 - j]).sum();
+            c[k][W_SHAFT] = -p.r_M * force_omega * inv_k;
+        }
+        true
+    }
+}
 
 impl Rattle {
     /// The free flight from (t0, y0), from its kept start if it is that one.

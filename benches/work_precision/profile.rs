@@ -7,6 +7,7 @@
 //! edges and rejected steps. This is what says which lever of issue 3 would pay.
 
 use super::*;
+use gear_rattle::integrator::taylor::Coefficients;
 use gear_rattle::integrator::{Edge, Jacobian, Piecewise, System};
 use gear_rattle::physics::Region;
 use std::cell::Cell;
@@ -82,6 +83,9 @@ impl Piecewise<N> for Counted {
     }
     fn guard_acceleration_bound(&self, t0: f64, y0: &State) -> f64 {
         self.inner.guard_acceleration_bound(t0, y0)
+    }
+    fn series(&self, t: f64, y: &State, c: &mut Coefficients<N>) -> bool {
+        self.inner.series(t, y, c)
     }
 }
 
@@ -169,8 +173,8 @@ pub fn run(scenes: &[Scene]) {
         per_run * 1e3
     );
     println!(
-        "work: {} RHS, {} accepted + {} rejected steps, {} edges crossed",
-        run.rhs, solver.stats.accepted, solver.stats.rejected, run.edges
+        "work: {} RHS, {} accepted + {} rejected steps ({} of them Taylor steps), {} edges crossed",
+        run.rhs, solver.stats.accepted, solver.stats.rejected, solver.stats.series_steps, run.edges
     );
     println!(
         "free flight in closed form: {} evaluations of the exact solution, {} RHS in the gap",

@@ -13,7 +13,7 @@ const MAGIC: &[u8; 4] = b"GRFS";
 /// 3: the gear pair keeps the start of the free flight it passes through; 4: that start
 /// and the dynamics also keep the constants derived from the parameters (λ, 1/λ, u∞,
 /// 1/r_L, 1/I_L) and the bench's sine its amplitudes A/w and A/w².
-const VERSION: u16 = 4;
+const VERSION: u16 = 5;
 const HEADER: usize = 4 + 2 + 4;
 const TRAILER: usize = 4;
 

@@ -9,6 +9,7 @@
 //!   steps, their exit found by a root search that cannot step over a crossing.
 //! - [`radau5`]: the Radau IIA method of order 5 for stiff phases, one step at a time.
 //! - [`stiffness`]: when to hand over from one method to the other.
+//! - [`taylor`]: Taylor-series steps, where the system gives the series of its piece.
 //! - [`solver`]: the driver that reaches an exact end time, carries the step size and method
 //!   over from one call to the next, and ends steps exactly on the edges of the system's
 //!   pieces.
@@ -24,6 +25,7 @@ pub mod roots;
 pub mod serde_array;
 pub mod solver;
 pub mod stiffness;
+pub mod taylor;
 #[cfg(test)]
 mod test_systems;
 #[cfg(test)]
@@ -95,6 +97,14 @@ pub trait Piecewise<const N: usize>: System<N> {
     /// search from stepping over a crossing.
     fn guard_acceleration_bound(&self, _t0: f64, _y0: &[f64; N]) -> f64 {
         f64::INFINITY
+    }
+
+    /// Where the current piece's solution is analytic and the system can form its Taylor
+    /// coefficients about (t, y): writes them into `c` and returns true; the solver then takes
+    /// Taylor steps in the piece ([`taylor`]) while it steps explicitly. False (the default):
+    /// DOPRI5 or Radau IIA steps.
+    fn series(&self, _t: f64, _y: &[f64; N], _c: &mut taylor::Coefficients<N>) -> bool {
+        false
     }
 
     /// Moves to the piece that contains `y[GUARD]` through each edge on the way (after a

@@ -23,7 +23,7 @@ use super::passage::Passage;
 use super::radau5::{Jacobian, RadauTrial, Stepper};
 use super::roots::illinois;
 use super::stiffness::{Switch, spectral_radius, stiffness};
-use super::{Dense, Edge, Piecewise};
+use super::{Dense, Edge, Piecewise, taylor};
 use serde::{Deserialize, Serialize};
 
 /// Work counters.
@@ -43,6 +43,8 @@ pub struct Stats {
     pub switches: u64,
     /// Evaluations of a piece's solution in closed form (the free flight), in place of steps.
     pub exact_evals: u64,
+    /// Accepted steps taken by Taylor series ([`taylor`]; counted in `accepted` too).
+    pub series_steps: u64,
 }
 
 /// Why the solver stopped short of the end time. The state is left at the last good point.
@@ -135,7 +137,7 @@ struct Ahead<const N: usize> {
     t0: f64,
     h: f64,
     /// The step's dense output.
-    dense: dopri5::Continuous<N>,
+    dense: Interpolant<N>,
     #[serde(with = "super::serde_array")]
     y1: [f64; N],
     /// The edge the step ends on, to be crossed when a call goes past it.
@@ -159,6 +161,22 @@ impl<const N: usize> Ahead<N> {
         *y = self.dense.at((t_end - self.t0) / self.h);
         *t = t_end;
         self.left_off = LeftOff::at(t_end, y);
+    }
+}
+
+/// The dense output of a kept step, whichever explicit method took it.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+enum Interpolant<const N: usize> {
+    Dopri5(dopri5::Continuous<N>),
+    Taylor(taylor::Step<N>),
+}
+
+impl<const N: usize> Interpolant<N> {
+    fn at(&self, theta: f64) -> [f64; N] {
+        match self {
+            Interpolant::Dopri5(c) => c.at(theta),
+            Interpolant::Taylor(s) => s.at(theta),
+        }
     }
 }
 
@@ -325,14 +343,28 @@ impl<const N: usize> Solver<N> {
         }
         let mut steps = 0u64;
         let mut crossings_here = 0u32;
-        // The DOPRI5 steps are written here in place (see `dopri5::step`).
+        // The DOPRI5 steps are written here in place (see `dopri5::step`), the series too.
         let mut trial = dopri5::Trial::empty();
+        let mut series = [[0.0; N]; taylor::TERMS];
         while *t < t_end {
             if !self.just_crossed && sys.settle(*t, y) > 0 {
                 self.invalidate();
             }
             if sys.has_exact() {
                 if self.pass(sys, t, y, t_end)? {
+                    continue;
+                }
+                return Ok(());
+            }
+            if !self.implicit && sys.series(*t, y, &mut series) {
+                steps += 1;
+                if steps > self.max_steps {
+                    return Err(SolverError::TooManySteps {
+                        t: *t,
+                        steps: self.max_steps,
+                    });
+                }
+                if self.series_step(sys, &series, t, y, t_end, &mut crossings_here)? {
                     continue;
                 }
                 return Ok(());
@@ -483,6 +515,72 @@ impl<const N: usize> Solver<N> {
         }
     }
 
+    /// A Taylor step from (t, y) with the series `c` of the current piece: as long as the
+    /// tolerance allows, or to t_end, or to an edge inside it, which is then crossed. False
+    /// when the step reaches past t_end and is kept for the next call (`interpolate_ends`),
+    /// t_end served from it.
+    fn series_step<S: Piecewise<N>>(
+        &mut self,
+        sys: &mut S,
+        c: &taylor::Coefficients<N>,
+        t: &mut f64,
+        y: &mut [f64; N],
+        t_end: f64,
+        crossings_here: &mut u32,
+    ) -> Result<bool, SolverError> {
+        let step_past = self.interpolate_ends;
+        let natural = taylor::Step::length(c, &self.tol);
+        let last = !natural.is_finite() || (!step_past && *t + 1.01 * natural >= t_end);
+        let h = if last { t_end - *t } else { natural };
+        if h <= 16.0 * f64::EPSILON * t.abs().max(t_end.abs()) {
+            return Err(SolverError::StepTooSmall { t: *t, h });
+        }
+        let step = taylor::Step::new(*c, h);
+        self.stats.accepted += 1;
+        self.stats.series_steps += 1;
+        // What DOPRI5 knew of this point and of the piece's entry does not carry over.
+        self.k1_valid = false;
+        self.entering = None;
+        let (lo, hi) = sys.piece();
+        if let Some((edge, theta)) = locate_edge(&step, (S::GUARD, S::RATE), lo, hi) {
+            if step_past && *t + theta * h > t_end {
+                // The edge lies past t_end: the step up to it is kept, as DOPRI5's is.
+                let kept = taylor::Step::new(*c, theta * h);
+                self.keep(
+                    Interpolant::Taylor(kept),
+                    kept.h,
+                    kept.y1,
+                    Some(edge),
+                    t,
+                    y,
+                    t_end,
+                );
+                return Ok(false);
+            }
+            if theta > 0.0 {
+                *y = step.at(theta);
+                *t += theta * h;
+                *crossings_here = 0;
+            } else {
+                *crossings_here += 1;
+                if *crossings_here > MAX_CROSSINGS_AT_ONCE {
+                    return Err(SolverError::Chattering { t: *t });
+                }
+            }
+            self.cross(sys, edge, *t, y);
+            return Ok(true);
+        }
+        *crossings_here = 0;
+        self.just_crossed = false;
+        if step_past && *t + h > t_end {
+            self.keep(Interpolant::Taylor(step), h, step.y1, None, t, y, t_end);
+            return Ok(false);
+        }
+        *t = if last { t_end } else { *t + h };
+        *y = step.y1;
+        Ok(true)
+    }
+
     /// Crosses `edge` at (t, y): the system changes piece, and what was known of the old one
     /// goes.
     fn cross<S: Piecewise<N>>(&mut self, sys: &mut S, edge: Edge, t: f64, y: &[f64; N]) {
@@ -509,11 +607,28 @@ impl<const N: usize> Solver<N> {
         y: &mut [f64; N],
         t_end: f64,
     ) {
+        let dense = Interpolant::Dopri5(step.continuous());
+        self.keep(dense, step.h, step.y1, edge, t, y, t_end);
+    }
+
+    /// Keeps a step from (t, y) of length h to y1 that reaches past t_end and hands out
+    /// (t_end, y(t_end)) from its dense output.
+    #[allow(clippy::too_many_arguments)]
+    fn keep(
+        &mut self,
+        dense: Interpolant<N>,
+        h: f64,
+        y1: [f64; N],
+        edge: Option<Edge>,
+        t: &mut f64,
+        y: &mut [f64; N],
+        t_end: f64,
+    ) {
         let mut ahead = Ahead {
             t0: *t,
-            h: step.h,
-            dense: step.continuous(),
-            y1: step.y1,
+            h,
+            dense,
+            y1,
             edge,
             left_off: LeftOff::at(t_end, y),
         };

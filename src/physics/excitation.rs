@@ -171,6 +171,36 @@ impl Excitation {
         }
     }
 
+    /// Taylor coefficients about t of ω_M and a_M, to M terms: for the sine, the k-th
+    /// derivatives of ω̄ − A/w cos(wt) and A sin(wt) over k!; the polynomial's are exact.
+    pub fn series<const M: usize>(&self, t: f64) -> ([f64; M], [f64; M]) {
+        let (mut omega, mut alpha) = ([0.0; M], [0.0; M]);
+        match self {
+            Excitation::Sine(s) => {
+                let (sin, cos) = crate::math::sin_cos(s.w * t);
+                // sin and cos of wt + kπ/2, k = 0..3.
+                let quarter = [(sin, cos), (cos, -sin), (-sin, -cos), (-cos, sin)];
+                let mut scale = 1.0; // w^k / k!
+                for k in 0..M {
+                    let (sin_k, cos_k) = quarter[k % 4];
+                    omega[k] = -s.a_over_w * scale * cos_k;
+                    alpha[k] = s.amplitude * scale * sin_k;
+                    scale *= s.w / (k + 1) as f64;
+                }
+                omega[0] += s.omega_mean;
+            }
+            Excitation::Polynomial(p) => {
+                let now = p.at(t);
+                omega[0] = now.omega;
+                alpha[0] = now.alpha;
+                if M > 1 {
+                    omega[1] = now.alpha;
+                }
+            }
+        }
+        (omega, alpha)
+    }
+
     /// The largest |a_M| at any time: A for the sine, |α| for the polynomial.
     pub fn max_acceleration(&self) -> f64 {
         match self {

@@ -9,9 +9,11 @@ pub mod excitation;
 pub mod flight;
 pub mod motion;
 pub mod params;
+pub mod series;
 
 pub use contact::{ContactLaw, ForceSlopes, Region};
 pub use excitation::{Excitation, Polynomial, Shaft, Sine, TorqueRamp};
 pub use flight::{Flight, FlightStart};
 pub use motion::{Dynamics, Loads, MainShaft};
 pub use params::{GearParams, ParamError};
+pub use series::ContactSeries;

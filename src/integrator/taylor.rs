@@ -1,0 +1,110 @@
+//! Taylor-series steps, for pieces whose solution has Taylor coefficients that the system can
+//! form ([`super::Piecewise::series`]): one step is the series about its start, as long as
+//! its last two terms allow for the tolerance (Jorba and Zou's rule), and its polynomial is
+//! its own dense output, so an edge inside it is reached by evaluating it there, not by a
+//! redone step.
+
+use serde::{Deserialize, Serialize};
+
+use super::{Dense, Tolerance};
+use crate::math;
+
+/// Number of Taylor coefficients per component: order 11. Measured on single contact visits
+/// of S1 (`BENCH_TAYLOR=1` of the benchmark): orders 9, 11 and 13 came within a fifth of one
+/// another at equal error, 11 most often the cheapest.
+pub const TERMS: usize = 12;
+
+/// y_i(t + τ) = Σ_k c[k][i] τ^k, k < [`TERMS`].
+pub type Coefficients<const N: usize> = [[f64; N]; TERMS];
+
+/// Share of the error weights (atol + rtol·|y|) given to a step's truncation error, the
+/// series' last two terms. DOPRI5's weight bounds its embedded 4th-order estimate, which
+/// overstates the error of the 5th-order solution it propagates; the last terms of a series
+/// are close to its truncation error, hence the smaller share. Chosen on S1 so that both
+/// methods give the same error at a given rtol (test `taylor_steps_match_dopri5` in rattle).
+pub const SHARE: f64 = 1.0;
+
+/// One step of length h from its coefficients, with its end.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Step<const N: usize> {
+    pub h: f64,
+    #[serde(with = "super::serde_array::rows")]
+    c: Coefficients<N>,
+    #[serde(with = "super::serde_array")]
+    pub y1: [f64; N],
+}
+
+impl<const N: usize> Step<N> {
+    /// The step of length h from the series `c` about its start.
+    pub fn new(c: Coefficients<N>, h: f64) -> Self {
+        let mut step = Step { h, c, y1: [0.0; N] };
+        step.y1 = step.at(1.0);
+        step
+    }
+
+    /// The longest step for the tolerance: for each controlled component with weight
+    /// w = atol + rtol·|y0|, the last two terms |c_k| τ^k must stay within SHARE·w.
+    pub fn length(c: &Coefficients<N>, tol: &Tolerance<N>) -> f64 {
+        // min over the terms of (w / |c_k|)^(1/k), in log2 (coarse: the length needs no
+        // more than a few digits, and powf was a tenth of a step's cost).
+        let mut log_h = f64::INFINITY;
+        for i in 0..tol.controlled {
+            let log_w = math::log2_coarse(SHARE * (tol.atol[i] + tol.rtol * c[0][i].abs()));
+            for k in [TERMS - 2, TERMS - 1] {
+                let ck = c[k][i].abs();
+                if ck > 0.0 {
+                    log_h = log_h.min((log_w - math::log2_coarse(ck)) / k as f64);
+                }
+            }
+        }
+        if log_h.is_finite() {
+            math::exp2_coarse(log_h)
+        } else {
+            f64::INFINITY
+        }
+    }
+
+    /// The state at t + θh, θ ∈ [0, 1].
+    pub fn at(&self, theta: f64) -> [f64; N] {
+        std::array::from_fn(|i| self.dense(i, theta))
+    }
+}
+
+impl<const N: usize> Dense<N> for Step<N> {
+    fn ends(&self) -> (&[f64; N], &[f64; N]) {
+        (&self.c[0], &self.y1)
+    }
+
+    fn dense(&self, i: usize, theta: f64) -> f64 {
+        let tau = theta * self.h;
+        self.c.iter().rev().fold(0.0, |acc, c| acc * tau + c[i])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// y = e^(−t), y' = −y: c_k = (−1)^k / k!; a step reproduces e^(−h) within the weight
+    /// its length was chosen for, and its dense output e^(−θh).
+    #[test]
+    fn exponential_within_the_weight() {
+        let mut c = [[0.0; 1]; TERMS];
+        let mut term = 1.0;
+        for (k, ck) in c.iter_mut().enumerate() {
+            ck[0] = term;
+            term *= -1.0 / (k + 1) as f64;
+        }
+        let tol = Tolerance {
+            rtol: 1e-10,
+            atol: [1e-10],
+            controlled: 1,
+        };
+        let h = Step::length(&c, &tol);
+        assert!(h > 0.1 && h < 1.0, "{h}");
+        let step = Step::new(c, h);
+        assert!((step.y1[0] - (-h).exp()).abs() <= SHARE * 2e-10);
+        assert!((step.dense(0, 0.5) - (-0.5 * h).exp()).abs() <= SHARE * 2e-10);
+        assert_eq!(step.ends().0, &[1.0]);
+    }
+}
