@@ -63,11 +63,7 @@ impl<const M: usize> ContactSeries<M> {
         for k in 0..M - 2 {
             if k > 0 {
                 u[k] = sigma_over_G * s.xi[k];
-                let mut acc = 0.0;
-                for j in 1..=k {
-                    acc += (p.alpha * j as f64 - (k - j) as f64) * u[j] * v[k - j];
-                }
-                v[k] = acc * inv_u0 / k as f64;
+                v[k] = power_term(p.alpha, &u, &v, k, inv_u0);
             }
             let rate = (k + 1) as f64 * s.xi[k + 1];
             s.force[k] = scale * v[k] + p.C_LM * rate;
@@ -79,5 +75,76 @@ impl<const M: usize> ContactSeries<M> {
             s.xi[k + 2] = xi_ddot / ((k + 1) * (k + 2)) as f64;
         }
         Some(s)
+    }
+}
+
+/// The term k ≥ 1 of v = u^a from u's terms 0..=k and v's 0..k (1/u₀ given):
+/// k u₀ v_k = Σ_{j=1..k} (a j − (k − j)) u_j v_{k−j}, from u v' = a u' v.
+#[inline]
+fn power_term(a: f64, u: &[f64], v: &[f64], k: usize, inv_u0: f64) -> f64 {
+    let mut acc = 0.0;
+    for j in 1..=k {
+        acc += (a * j as f64 - (k - j) as f64) * u[j] * v[k - j];
+    }
+    acc * inv_u0 / k as f64
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::physics::{GearParams, Sine};
+
+    /// (2 + 3τ)^a for a = 4/3, 3/2, 1 and 10/9: the terms are 2^a C(a, k) (3/2)^k.
+    #[test]
+    fn power_terms_are_binomial() {
+        for a in [4.0 / 3.0, 1.5, 1.0, 10.0 / 9.0] {
+            let u = [2.0, 3.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0];
+            let mut v = [0.0; 12];
+            v[0] = 2f64.powf(a);
+            let mut binomial = v[0];
+            for k in 1..12 {
+                v[k] = power_term(a, &u, &v, k, 0.5);
+                binomial *= (a - (k - 1) as f64) / k as f64 * 1.5;
+                assert!(
+                    (v[k] - binomial).abs() <= 1e-14 * binomial.abs().max(1e-3),
+                    "a {a}, k {k}: {} vs {binomial}",
+                    v[k]
+                );
+            }
+        }
+    }
+
+    /// A linear spring (α = 1) with no damping, drag or forcing: ξ = δ₀ cos ωt + (ξ'₀/ω)
+    /// sin ωt on F+, ω² = r_L² K*/I_L; every term of the series against the cosine's and
+    /// sine's.
+    #[test]
+    fn linear_contact_gives_the_harmonic_terms() {
+        let mut p = GearParams::paper();
+        (p.alpha, p.C, p.C_LM) = (1.0, 0.0, 0.0);
+        let dynamics = Dynamics::new(p);
+        let still = Excitation::Sine(Sine::new(0.0, 30.0, 0.0));
+        let (xi0, xi_dot0) = (-3e-6, 0.004);
+        let s = ContactSeries::<12>::new(&dynamics, &still, Region::ContactPlus, 0.3, xi0, xi_dot0)
+            .expect("full contact");
+        let w = (p.r_L * p.r_L * p.K_star / p.I_L).sqrt();
+        let mut scale = 1.0; // w^k / k!
+        for k in 0..12 {
+            let expected = match k % 4 {
+                0 => xi0,
+                1 => xi_dot0 / w,
+                2 => -xi0,
+                _ => -xi_dot0 / w,
+            } * scale;
+            assert!(
+                (s.xi[k] - expected).abs() <= 1e-12 * (xi0.abs() * scale),
+                "k {k}: {} vs {expected}",
+                s.xi[k]
+            );
+            scale *= w / (k + 1) as f64;
+        }
+        assert!(
+            ContactSeries::<12>::new(&dynamics, &still, Region::BandPlus, 0.3, -0.5e-6, 0.0)
+                .is_none()
+        );
     }
 }
