@@ -417,6 +417,43 @@ mod tests {
         assert!(!gap.series(0.0, &[1e-5, 0.0, 0.0, 0.0, 0.0], &mut [[0.0; N]; TERMS]));
     }
 
+    /// With `interpolate_ends`, the end times asked for change no bit of the trajectory:
+    /// S2 (chaotic, so any difference would grow) over 31 ms, served every 2^-10 s and every
+    /// 2^-13 s (binary fractions, so the common points are the same times), bands, contacts
+    /// and flights included. The first DOPRI5 step had been capped by the first call's length.
+    #[test]
+    fn end_times_change_no_bit_of_the_trajectory() {
+        use crate::integrator::Solver;
+        let p = GearParams::paper();
+        let run = |dt: f64| {
+            let mut sys = Rattle::new(
+                Dynamics::new(p),
+                Excitation::Sine(Sine::new(300.0, 60.0, 0.0)),
+                0.5 * p.G,
+            );
+            let mut solver = Solver::new(sys.tolerance(1e-6));
+            solver.interpolate_ends = true;
+            let (mut t, mut y) = (0.0, [0.5 * p.G, 0.0, 0.0, 0.0, 0.0]);
+            let n = (0.03125 / dt) as usize;
+            let every = (2f64.powi(-10) / dt) as usize;
+            let mut at_common = vec![];
+            for k in 1..=n {
+                solver
+                    .advance(&mut sys, &mut t, &mut y, k as f64 * dt)
+                    .unwrap();
+                if k % every == 0 {
+                    at_common.push(y.map(f64::to_bits));
+                }
+            }
+            (at_common, sys.impacts.count)
+        };
+        let (coarse, impacts) = run(2f64.powi(-10));
+        let (fine, _) = run(2f64.powi(-13));
+        assert!(impacts[0] + impacts[1] >= 4, "{impacts:?}");
+        assert_eq!(coarse.len(), 32);
+        assert_eq!(coarse, fine);
+    }
+
     /// The free flight's kept start changes no bit of the exact solution, and a flight from
     /// elsewhere does not use it.
     #[test]

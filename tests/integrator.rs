@@ -110,9 +110,7 @@ fn the_step_size_carries_over_between_calls() {
 }
 
 /// With end times served from the dense output, 20 000 calls (one per millisecond) cost
-/// the right-hand sides of one call (but for the first step, whose size is capped by the
-/// first call's length and grows back from there), and each end is as accurate as the steps
-/// around it.
+/// the right-hand sides of one call, and each end is as accurate as the steps around it.
 #[test]
 fn interpolated_ends_cost_nothing_and_keep_the_accuracy() {
     let (e1, one_call) = adaptive(1e-8, 1, true);

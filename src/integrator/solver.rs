@@ -371,7 +371,15 @@ impl<const N: usize> Solver<N> {
             }
             let k1 = self.derivative(sys, *t, y);
             if self.h <= 0.0 {
-                self.h = self.initial_step(sys, *t, y, &k1, t_end - *t);
+                // Capped by the call's length only where steps end on t_end: with
+                // `interpolate_ends` the first step must not depend on the end time asked
+                // for, or neither would the trajectory.
+                let h_max = if self.interpolate_ends && !self.implicit {
+                    f64::INFINITY
+                } else {
+                    t_end - *t
+                };
+                self.h = self.initial_step(sys, *t, y, &k1, h_max);
             }
             // The first DOPRI5 step into a piece just entered starts from what was learnt of
             // that piece's entries.
