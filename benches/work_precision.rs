@@ -14,15 +14,13 @@
 //! interleaved configurations (default 1.5), BENCH_OUT=path of the CSV.
 //! BENCH_DEBUG=gr|dopri5|dop853|tsit45 with BENCH_DEBUG_RTOL=r (and BENCH_DEBUG_SCENE, default
 //! S1-0.2s): one run, printed against the reference point by point (t, ξ, Δξ, impacts).
-//! BENCH_PROFILE=1 or calls: see `profile`. BENCH_TAYLOR=1: see `taylor`.
+//! BENCH_PROFILE=1 or calls: see `profile`.
 #![allow(non_snake_case)]
 
 #[path = "work_precision/peers.rs"]
 mod peers;
 #[path = "work_precision/profile.rs"]
 mod profile;
-#[path = "work_precision/taylor.rs"]
-mod taylor;
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -681,10 +679,6 @@ fn main() {
                 out.0.run.counts[j]
             );
         }
-        return;
-    }
-    if std::env::var("BENCH_TAYLOR").is_ok_and(|v| v == "1") {
-        taylor::run();
         return;
     }
     if std::env::var("BENCH_PROFILE").is_ok_and(|v| v == "1") {

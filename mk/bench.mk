@@ -23,7 +23,7 @@ bench: fmu $(VENV)/.installed $(BENCH_REF) | libclang
 	echo "Load average at the end: $$(cut -d' ' -f1-3 /proc/loadavg) (1, 5, 15 min)." >> $(BENCH_DIR)/machine.txt; \
 	$(PY) scripts/bench_report.py --started $$started
 
-## bench-profile: GearRattle alone on S1 under perf -> target/bench/profile.txt, the cost of a call -> calls.txt, a Taylor step in the contacts -> taylor.txt (part of bench)
+## bench-profile: GearRattle alone on S1 under perf -> target/bench/profile.txt, the cost of a call -> calls.txt (part of bench)
 # The bench binary is built first and recorded alone, so that no compiler shows in the profile.
 BENCH_PROFILE_RTOL ?= 1e-7
 bench-profile: | libclang
@@ -40,8 +40,7 @@ bench-profile: | libclang
 		BENCH_PROFILE=1 BENCH_PROFILE_RTOL=$(BENCH_PROFILE_RTOL) $$exe --bench > $(BENCH_DIR)/profile.txt; \
 	fi; \
 	BENCH_PROFILE=calls BENCH_PROFILE_RTOL=$(BENCH_PROFILE_RTOL) BENCH_PROFILE_SECONDS=2 $$exe --bench > $(BENCH_DIR)/calls.txt; \
-	BENCH_TAYLOR=1 $$exe --bench > $(BENCH_DIR)/taylor.txt; \
-	cat $(BENCH_DIR)/profile.txt $(BENCH_DIR)/calls.txt $(BENCH_DIR)/taylor.txt
+	cat $(BENCH_DIR)/profile.txt $(BENCH_DIR)/calls.txt
 
 ## bench-reference: the independent reference solutions of the benchmark scenes
 bench-reference: $(BENCH_REF)

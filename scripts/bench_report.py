@@ -5,8 +5,8 @@ docs/BENCHMARKS.md (issue 3).
 
 Reads target/bench/rust.csv (cargo bench -p gear_rattle_bench --bench work_precision), target/bench/python.csv
 (scripts/bench_python.py), target/bench/reference/scenes.csv (scripts/bench_reference.py)
-and, when present, target/bench/profile.txt, calls.txt, taylor.txt and machine.txt (written
-by mk/bench.mk). Ratios, not absolute times, carry the claims.
+and, when present, target/bench/profile.txt, calls.txt and machine.txt (written by
+mk/bench.mk). Ratios, not absolute times, carry the claims.
 """
 
 from __future__ import annotations
@@ -277,18 +277,24 @@ def analysis(rows, s1, r_rust, n_rust, r_user, n_user, r_py, n_py, comm_rows, to
             contact_pct = sum(v["pct"] for v in contacts)
             a(f"**Profile of GearRattle alone** (S1, 1 s, rtol {p.get('rtol', float('nan')):g}; RHS counted per "
               "region through a wrapper of `Rattle`, RHS cost per region timed in a loop, perf for the symbols): "
-              f"{p['rhs']} RHS, {p['accepted']} accepted and {p['rejected']} rejected steps, {p['edges']} edges. "
-              f"Right-hand sides take {p['rhs_cpu']:.0f} % of the CPU time; the integrator around them (stages, "
-              f"error norm, step control, edge search, output stops) {p['other_cpu']:.0f} %, i.e. "
+              f"{p['rhs']} RHS, {p['accepted']} accepted steps ({p.get('series', 0)} of them Taylor steps in full "
+              f"contact) and {p['rejected']} rejected, {p['edges']} edges. "
+              f"Right-hand sides take {p['rhs_cpu']:.0f} % of the CPU time; the integrator around them (DOPRI5's "
+              f"stages, the Taylor steps, error norm, step control, edge search, output stops) {p['other_cpu']:.0f} %, i.e. "
               f"{p['other_ns']:.0f} ns per RHS. By region: contact {contact_pct:.0f} % of the RHS, bands "
               f"{band_pct:.0f} %, free flight {gap['pct']:.0f} %" +
               (f" (the gap is crossed in closed form: {p['flight_evals']} evaluations of the exact solution "
                "instead of steps)" if "flight_evals" in p else "") +
               f". Edges cost {p['edge_pct']:.0f} % of the RHS "
-              f"(each: the step redone to land on it and a new first stage), rejected steps {p['reject_pct']:.0f} %.")
+              f"(each crossed by DOPRI5: the step redone to land on it and a new first stage; a Taylor step "
+              f"crosses at its own polynomial), rejected steps {p['reject_pct']:.0f} %.")
             a("")
             a("Levers of issue 3 in place: steps end on the band edges; the gap is crossed in closed form (a root "
-              "search on the exact free flight that cannot step over a crossing); a cheap right-hand side (table "
+              "search on the exact free flight that cannot step over a crossing); the full contacts are crossed by "
+              "Taylor-series steps of order 11 (`integrator::taylor`, `physics::series`: where δ stays at least ε "
+              "from the kink of δ^(4/3) the coefficients follow by the recurrence of a power, a step is as long as "
+              "its last two terms allow, and its polynomial is its own dense output, so an edge needs no redone "
+              "step); a cheap right-hand side (table "
               "cube root, the excitation's sine and cosine by fdlibm's kernels, inlined, the band's sin² as a polynomial, no powf for "
               "α = 4/3); no allocation on the stepping path (each DOPRI5 step written in place); the stages form "
               "only ξ and ξ' (the energy quadratures advance at the step's end); the first step into a piece "
@@ -339,11 +345,10 @@ def analysis(rows, s1, r_rust, n_rust, r_user, n_user, r_py, n_py, comm_rows, to
                   "same RHS; it moves it against the peers as users write them, and it moves the absolute cost, "
                   "which is what a user sees. Against peers with the same RHS and the same edge handling, 3× would "
                   "take fewer steps inside the contacts and bands, where the steps now are (MODEL.md: higher orders "
-                  "did not pay, each band crossing costs 2-3 steps whatever the order). The lever left is a step "
-                  "that covers more of a contact at once: a Taylor-series step of high order inside the "
-                  "full-contact regions, where δ stays at least ε from the kink of δ^(4/3), so that its Taylor "
-                  "coefficients follow by the recurrence of a power; its polynomial is its own dense output, so an "
-                  "edge needs no redone step. " + taylor_lever() + "Tried and "
+                  "did not pay, each band crossing costs 2-3 steps whatever the order). The Taylor steps took the "
+                  "full contacts; the bands are still DOPRI5's, and they are the lever left: their force "
+                  "s(δ)·K* δ|δ/G|^(α−1) has Taylor series wherever δ ≠ 0, but they converge only within |δ| of the "
+                  "band's edge with the gap, which every contact enters and leaves through. Tried and "
                   "dropped (code not kept; their figures are in issue 3's closing notes of sessions 4 to 6): crossing an "
                   "edge at the straddling step's dense output instead of redoing the step (fewer RHS, but three "
                   "cases of the stress suite, make stability, failed, among them ε = 0 and the energy balance); "
@@ -384,32 +389,6 @@ def analysis(rows, s1, r_rust, n_rust, r_user, n_user, r_py, n_py, comm_rows, to
           "the Rust one costs tens of nanoseconds, and solve_ivp restarts at every edge (a new first step each "
           "time). The ratio is dominated by the interpreter, not by the method.")
     return "\n".join(out)
-
-
-def taylor_lever() -> str:
-    """What `make bench-profile` measured of a Taylor step in the contacts (target/bench/taylor.txt)."""
-    path = BENCH / "taylor.txt"
-    if not path.is_file():
-        return "It is not measured in this run (target/bench/taylor.txt is missing). "
-    text = path.read_text()
-    ratios = [float(x) for x in re.findall(r"at the error of DOPRI5 rtol \S+: Taylor \S+ tol \S+, ([0-9.]+)× less CPU", text)]
-    steps = [int(x) for x in re.findall(r"Taylor P=\d+ tol \S+\s+(\d+) steps", text)]
-    rhs = [int(x) for x in re.findall(r"DOPRI5 rtol \S+\s+(\d+) RHS in contact", text)]
-    if not (ratios and steps and rhs):
-        return "Its measurement (target/bench/taylor.txt) could not be read. "
-    text = (f"Measured outside the solver (`BENCH_TAYLOR=1`, section below) on three contact visits of S1: "
-            f"{min(steps)}-{max(steps)} Taylor steps of order 10-14 per visit where DOPRI5 takes {min(rhs)}-{max(rhs)} "
-            f"RHS, and {min(ratios):.1f}-{max(ratios):.1f}× less CPU at equal error at the visit's exit. ")
-    prof = BENCH / "profile.txt"
-    regions = parse_profile(prof.read_text())["regions"] if prof.is_file() else {}
-    contact = sum(v["pct"] for k, v in regions.items() if k.startswith("contact")) / 100
-    if contact:
-        # The contacts' share of the CPU taken as their share of the RHS (the stepping around each RHS
-        # costs about the same in every region); the bands stay with DOPRI5.
-        gain = [1 / (1 - contact + contact / r) for r in (min(ratios), max(ratios))]
-        text += (f"The full contacts take {contact * 100:.0f} % of the RHS on S1 (profile above); with the bands "
-                 f"left to DOPRI5, S1 would run {gain[0]:.1f}-{gain[1]:.1f}× faster. ")
-    return text + "The step is not in the solver yet. "
 
 
 def calls_split() -> str:
@@ -628,8 +607,8 @@ def main() -> None:
     w("  3. `cargo bench -p gear_rattle_bench --bench work_precision` (target/bench/rust.csv; `BENCH_QUICK=1` for a smoke run, "
       "`BENCH_SCENES=S1-1s,...` for a subset);")
     w("  4. `.venv/bin/python scripts/bench_python.py` (target/bench/python.csv; `--scenes all` for every scene);")
-    w("  5. `perf record` of GearRattle alone on S1 (target/bench/profile.txt, when perf is available), the cost "
-      "of a call (calls.txt) and a Taylor step in the contacts (taylor.txt): `make bench-profile`;")
+    w("  5. `perf record` of GearRattle alone on S1 (target/bench/profile.txt, when perf is available) and the "
+      "cost of a call (calls.txt): `make bench-profile`;")
     w("  6. `.venv/bin/python scripts/bench_report.py` (this file and docs/work_precision.png).")
     w("")
 
@@ -649,7 +628,9 @@ def main() -> None:
       "interleaved repeats (Rust: 3-9 within a 1.5 s budget per group; Python: 3 when a run is under 2 s, else 1); "
       "tolerances: the Rust integrators at every half decade from 1e-3 to 1e-10 (so that the interpolation at "
       "equal error brackets closely), the FMU runs and the Python peers at the decades; "
-      "RHS evaluations as counted in the RHS itself (peers) or by the integrator (GearRattle).")
+      "RHS evaluations as counted in the RHS itself (peers) or by the integrator (GearRattle, whose count "
+      "leaves out its Taylor steps in full contact: each forms the series of order 11 instead; CPU time "
+      "carries the comparison).")
     w("- GearRattle (direct): `Rattle` + `Solver::advance` to each 1 ms grid point, served from the dense output "
       "of its natural steps (`interpolate_ends`, as the FMU in sine mode), the gap crossed in closed form (its "
       "evaluations of the exact flight are not counted as RHS). Simulation::step_to: the FMU's simulation object stepped at the communication step "
@@ -803,20 +784,6 @@ def main() -> None:
         w("")
         w("```")
         w(prof.read_text().rstrip())
-        w("```")
-        w("")
-    taylor = BENCH / "taylor.txt"
-    if taylor.is_file():
-        w("## The lever left: a Taylor step inside the contacts")
-        w("")
-        w("One contact visit of S1 on flank F+ (full contact, from ξ = −ε inwards back to −ε) by GearRattle's DOPRI5 "
-          "and by a Taylor-series step of order P written in the benchmark (benches/work_precision/taylor.rs, not "
-          "in the solver), energies included (`BENCH_TAYLOR=1 cargo bench -p gear_rattle_bench --bench "
-          "work_precision`). DOPRI5 starts each visit from its initial step guess, where a run starts from what "
-          "earlier entries taught it; the Taylor code is not tuned.")
-        w("")
-        w("```")
-        w(taylor.read_text().rstrip())
         w("```")
         w("")
     failed = [r for r in rows if r["status"] not in ("ok",) and not r["status"].startswith("skipped")]

@@ -5,8 +5,8 @@
 //! - [`math`]: cheap elementary functions for the right-hand side (cube root, sine);
 //! - [`physics`]: contact law, equation of motion, excitation (MODEL.md), and the main
 //!   shaft's inertia for the torque mode;
-//! - [`integrator`]: adaptive DOPRI5 and Radau IIA with error control, dense outputs, the
-//!   hand-over between them, and edge location;
+//! - [`integrator`]: adaptive DOPRI5, Taylor-series steps and Radau IIA with error control,
+//!   dense outputs, the hand-over between them, and edge location;
 //! - [`rattle`]: the gear pair as a piecewise ODE for the integrator, with impact counting
 //!   (the shaft's motion imposed; [`rattle::torque`]: driven by a torque, 7 states);
 //! - [`instance`]: the co-simulation slave (FMI state machine, variables, stepping);

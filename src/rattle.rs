@@ -260,8 +260,12 @@ contact_pieces!(
 
 /// The coefficient k of a series squared, Σ_{j ≤ k} a_j a_{k−j}, each pair once.
 fn square(a: &[f64], k: usize) -> f64 {
-    let half: f64 = (0..(k + 1) / 2).map(|j| a[j] * a[k - j]).sum();
-    let middle = if k % 2 == 0 { a[k / 2] * a[k / 2] } else { 0.0 };
+    let half: f64 = (0..k.div_ceil(2)).map(|j| a[j] * a[k - j]).sum();
+    let middle = if k.is_multiple_of(2) {
+        a[k / 2] * a[k / 2]
+    } else {
+        0.0
+    };
     2.0 * half + middle
 }
 
@@ -292,13 +296,13 @@ impl Rattle {
         c[0][E_CONTACT] = y[E_CONTACT];
         c[0][E_LUBRICANT] = y[E_LUBRICANT];
         c[0][W_SHAFT] = y[W_SHAFT];
-        for k in 1..TERMS {
+        for (k, row) in c.iter_mut().enumerate().skip(1) {
             // The coefficient k − 1 of each rate, integrated: / k.
             let inv_k = 1.0 / k as f64;
-            c[k][E_CONTACT] = p.C_LM * square(&xi_dot, k - 1) * inv_k;
-            c[k][E_LUBRICANT] = p.C * square(&slip, k - 1) * inv_k;
+            row[E_CONTACT] = p.C_LM * square(&xi_dot, k - 1) * inv_k;
+            row[E_LUBRICANT] = p.C * square(&slip, k - 1) * inv_k;
             let force_omega: f64 = (0..k).map(|j| s.force[j] * s.omega_M[k - 1 - j]).sum();
-            c[k][W_SHAFT] = -p.r_M * force_omega * inv_k;
+            row[W_SHAFT] = -p.r_M * force_omega * inv_k;
         }
         true
     }

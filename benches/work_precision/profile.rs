@@ -24,25 +24,18 @@ fn index(r: Region) -> usize {
     REGIONS.iter().position(|(x, _)| *x == r).expect("a region")
 }
 
-/// `Rattle` with its right-hand sides counted per region, and the first edge it crossed.
-pub struct Counted {
-    pub inner: Rattle,
-    pub evals: Cell<[u64; 5]>,
-    pub first_cross: Option<(f64, State)>,
+/// `Rattle` with its right-hand sides counted per region.
+struct Counted {
+    inner: Rattle,
+    evals: Cell<[u64; 5]>,
 }
 
 impl Counted {
-    pub fn new(inner: Rattle) -> Self {
+    fn new(inner: Rattle) -> Self {
         Counted {
             inner,
             evals: Cell::new([0; 5]),
-            first_cross: None,
         }
-    }
-
-    /// Right-hand sides evaluated in `region`.
-    pub fn evals_in(&self, region: Region) -> u64 {
-        self.evals.get()[index(region)]
     }
 }
 
@@ -69,7 +62,6 @@ impl Piecewise<N> for Counted {
         self.inner.piece()
     }
     fn cross(&mut self, edge: Edge, t: f64, y: &State) {
-        self.first_cross.get_or_insert((t, *y));
         self.inner.cross(edge, t, y)
     }
     fn has_exact(&self) -> bool {

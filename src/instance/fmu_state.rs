@@ -12,7 +12,8 @@ use serde::{Deserialize, Serialize};
 const MAGIC: &[u8; 4] = b"GRFS";
 /// 3: the gear pair keeps the start of the free flight it passes through; 4: that start
 /// and the dynamics also keep the constants derived from the parameters (λ, 1/λ, u∞,
-/// 1/r_L, 1/I_L) and the bench's sine its amplitudes A/w and A/w².
+/// 1/r_L, 1/I_L) and the bench's sine its amplitudes A/w and A/w²; 5: the solver may keep a
+/// Taylor step past the end time and counts its Taylor steps.
 const VERSION: u16 = 5;
 const HEADER: usize = 4 + 2 + 4;
 const TRAILER: usize = 4;

@@ -47,11 +47,11 @@ impl<const N: usize> Step<N> {
     /// The longest step for the tolerance: for each controlled component with weight
     /// w = atol + rtol·|y0|, the last two terms |c_k| τ^k must stay within SHARE·w.
     pub fn length(c: &Coefficients<N>, tol: &Tolerance<N>) -> f64 {
-        // min over the terms of (w / |c_k|)^(1/k), in log2 (coarse: the length needs no
-        // more than a few digits, and powf was a tenth of a step's cost).
+        // min over the terms of (w / |c_k|)^(1/k), in log2 (coarse, as the step-size
+        // controller's powers: the length needs no more than a few digits).
         let mut log_h = f64::INFINITY;
-        for i in 0..tol.controlled {
-            let log_w = math::log2_coarse(SHARE * (tol.atol[i] + tol.rtol * c[0][i].abs()));
+        for (i, atol) in tol.atol.iter().enumerate().take(tol.controlled) {
+            let log_w = math::log2_coarse(SHARE * (atol + tol.rtol * c[0][i].abs()));
             for k in [TERMS - 2, TERMS - 1] {
                 let ck = c[k][i].abs();
                 if ck > 0.0 {

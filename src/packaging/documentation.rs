@@ -13,8 +13,9 @@ code,pre{background:#f4f4f4}</style></head><body>
 G. Chevallier, H. Sebbah, <i>Gear impacts and idle gear noise: experimental study and non-linear
 dynamic model</i>, Mechanical Systems and Signal Processing 23(8), 2009, pp. 2608-2628.
 FMI 2.0 Co-Simulation; the solver is inside (adaptive Dormand-Prince 5(4) with error control,
-handing over to Radau IIA of order 5 while the equations are stiff (parameter
-<code>solver</code>), and steps that end exactly on the edges of the contact law).</p>
+Taylor-series steps of order 11 in full contact, handing over to Radau IIA of order 5 while
+the equations are stiff (parameter <code>solver</code>), and steps that end exactly on the
+edges of the contact law).</p>
 <h2>Equations</h2>
 <p>Transmission error on the pitch line (the integrated coordinate, so hours of running lose
 no micrometres): <code>ξ = r_L θ_L − r_M θ_M</code>, <code>ξ' = r_L ω_L − r_M ω_M</code>.
