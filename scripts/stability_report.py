@@ -60,10 +60,10 @@ def cpu_samples(case: S.Case, driver: S.Driver, first: S.Run | None) -> list[flo
 
 def method_label(run: S.Run | None, has_switching: bool) -> str:
     if not has_switching:
-        return "DOPRI5 (only)"
+        return "explicit (only)"
     if run is None or not run.methods:
         return "-"
-    names = {1: "DOPRI5", 2: "Radau IIA"}
+    names = {1: "explicit", 2: "Radau IIA"}
     return " + ".join(names.get(m, str(m)) for m in run.methods)
 
 
@@ -152,7 +152,7 @@ def main() -> int:
     n_pass = sum(1 for _, v, _, _ in rows if v.passed)
     w(f"**{n_pass} of {len(rows)} cases pass.** FMU: `{fmu.relative_to(ROOT) if fmu.is_relative_to(ROOT) else fmu}`, "
       f"GUID {md.guid}, built from commit {git_state()}; implicit switching (`solver_method` output): "
-      f"{'present' if driver.has_switching else 'absent: DOPRI5 only'}.")
+      f"{'present' if driver.has_switching else 'absent: explicit only'}.")
     failing = [(c, v) for c, v, _, _ in rows if not v.passed]
     if failing:
         w("")

@@ -649,7 +649,7 @@ def _check_method(case: Case, run: Run, v: Verdict):
     if not run.methods:
         return
     if case.name.startswith("S1") and run.methods != (1,):
-        v.problems.append(f"S1 is not stiff but solver_method took the values {run.methods} (1 = DOPRI5 expected)")
+        v.problems.append(f"S1 is not stiff but solver_method took the values {run.methods} (1 = explicit expected)")
     if case.stiff and 2 not in run.methods:
         msg = f"stiff case, but solver_method was never 2 (Radau IIA) at a communication point: {run.methods}"
         (v.problems if case.expect_implicit else v.notes).append(msg)
