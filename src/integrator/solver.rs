@@ -172,6 +172,7 @@ enum Interpolant<const N: usize> {
 }
 
 impl<const N: usize> Interpolant<N> {
+    #[inline]
     fn at(&self, theta: f64) -> [f64; N] {
         match self {
             Interpolant::Dopri5(c) => c.at(theta),
