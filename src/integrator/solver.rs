@@ -2,16 +2,17 @@
 //! ends steps exactly on the edges of the pieces (so no step straddles a kink), and keeps its
 //! step size, method and controllers' memory from one call to the next.
 //!
-//! With `interpolate_ends`, DOPRI5 steps run past the end times and serve them from their
+//! With `interpolate_ends`, explicit steps run past the end times and serve them from their
 //! dense output, so that the trajectory and its cost do not depend on how often the caller
-//! asks (communication steps of 10 µs take the steps of 10 ms ones).
+//! asks (communication steps of 10 µs take the steps of 10 ms ones, bit for bit).
 //!
 //! A piece with a solution in closed form ([`Piecewise::has_exact`]) is crossed without
 //! steps: `passage` searches where that solution leaves the piece, and serves the end times
 //! inside it from the solution itself.
 //!
-//! The method is DOPRI5, or Radau IIA while the problem is stiff ([`Method::Auto`], the rule
-//! in `stiffness`), or either one throughout. Edges are located the same way on both methods'
+//! The method is DOPRI5, with Taylor-series steps in the pieces whose series the system gives
+//! ([`Piecewise::series`], `series_step`), or Radau IIA while the problem is stiff
+//! ([`Method::Auto`], the rule in `stiffness`), or either one throughout. Edges are located the same way on both methods'
 //! dense outputs. A non-stiff run pays for the implicit side only Hairer's stiffness
 //! estimate per accepted step (two weighted norms of the stages DOPRI5 has computed anyway).
 
