@@ -9,9 +9,8 @@ use serde::{Deserialize, Serialize};
 use super::{Dense, Tolerance};
 use crate::math;
 
-/// Number of Taylor coefficients per component: order 11. Measured on single contact visits
-/// of S1 (`BENCH_TAYLOR=1` of the benchmark): orders 9, 11 and 13 came within a fifth of one
-/// another at equal error, 11 most often the cheapest.
+/// Number of Taylor coefficients per component: order 11. On S1 at equal error, 10, 12 and
+/// 14 terms came within the machine's noise of one another (A/B runs recorded in issue 3).
 pub const TERMS: usize = 12;
 
 /// y_i(t + τ) = Σ_k c[k][i] τ^k, k < [`TERMS`].
@@ -20,10 +19,8 @@ pub type Coefficients<const N: usize> = [[f64; N]; TERMS];
 /// Share of the error weights (atol + rtol·|y|) given to a step's truncation error, the
 /// series' last two terms. DOPRI5's weight bounds its embedded 4th-order estimate, which
 /// overstates the error of the 5th-order solution it propagates; the last terms of a series
-/// are close to its truncation error, hence a smaller share. WIP, measured on S2 at rtol
-/// 1e-6 through fmpy (impact rates over 0.2-1 s, sum of both flanks): 1.0 gave 242.5 at a
-/// 1 ms and 257.5 at a 0.1 ms communication step, outside the 245-253.75 of 60 reference
-/// runs from perturbed starts (DOPRI5 alone: 248.75 and 250); 0.1 gave 251.25 and 248.75.
+/// are close to its truncation error, hence a smaller share. With 1.0, S2's impact rates fell
+/// outside what `test_sine_s2_statistics` (tests/python/test_fmu_sine.py) allows; 0.1 passes.
 pub const SHARE: f64 = 0.1;
 
 /// One step of length h from its coefficients, with its end.

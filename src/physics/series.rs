@@ -11,8 +11,8 @@
 
 use super::{Dynamics, Excitation, Region};
 
-/// Coefficients about t of the motion in full contact: ξ to M terms, F and ω_M to M − 2
-/// (the rest left 0), so that ξ and ξ' and the power flows come to M − 1 terms.
+/// Coefficients about t of the motion in full contact: ξ and ω_M to M terms, F to M − 2 (the
+/// rest left 0), so that ξ' and the power flows come to M − 1 terms.
 pub struct ContactSeries<const M: usize> {
     pub xi: [f64; M],
     /// Contact force F = F_k + F_c [N].
