@@ -56,6 +56,31 @@ const RECIPROCALS: [f64; ENTRIES] = {
     t
 };
 
+/// 1/k for k < 32 (1/0 left 0), for the Taylor recurrences: a multiply where a division by
+/// the term's index would sit on their chain of dependent operations.
+pub const INVERSES: [f64; 32] = {
+    let mut t = [0.0; 32];
+    let mut k = 1;
+    while k < 32 {
+        t[k] = 1.0 / k as f64;
+        k += 1;
+    }
+    t
+};
+
+/// The first K coefficients of the product of two series: p_k = Σ_{i+j=k} a_i b_j. With K
+/// known at compile time the loops unroll into independent multiply-adds.
+#[inline(always)]
+pub fn series_product<const K: usize>(a: &[f64; K], b: &[f64; K]) -> [f64; K] {
+    let mut p = [0.0; K];
+    for i in 0..K {
+        for j in 0..K - i {
+            p[i + j] += a[i] * b[j];
+        }
+    }
+    p
+}
+
 /// Cube root, for any f64, without division: x = 2^(3q+j)·m with m ∈ [1, 2) taken apart
 /// from its bits, cbrt(2^j·m_i) read from a table at the midpoint m_i of m's interval
 /// (256 intervals), and cbrt(1 + u), u = (m − m_i)/m_i, |u| < 2^-9, from its binomial series

@@ -11,6 +11,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::integrator::taylor::{Coefficients, TERMS};
 use crate::integrator::{Edge, Jacobian, Piecewise, System, Tolerance};
+use crate::math;
 use crate::physics::{
     ContactSeries, Dynamics, Excitation, Flight, FlightStart, GearParams, Loads, Region, Shaft,
 };
@@ -258,17 +259,6 @@ contact_pieces!(
     }
 );
 
-/// The coefficient k of a series squared, Σ_{j ≤ k} a_j a_{k−j}, each pair once.
-fn square(a: &[f64], k: usize) -> f64 {
-    let half: f64 = (0..k.div_ceil(2)).map(|j| a[j] * a[k - j]).sum();
-    let middle = if k.is_multiple_of(2) {
-        a[k / 2] * a[k / 2]
-    } else {
-        0.0
-    };
-    2.0 * half + middle
-}
-
 impl Rattle {
     /// Taylor coefficients of the state in full contact (see [`ContactSeries`]); the
     /// quadratures' are those of their rates (`power_flows`) integrated term by term.
@@ -286,23 +276,30 @@ impl Rattle {
         let p = &self.dynamics.params;
         let inv_r_L = 1.0 / p.r_L;
         let xi_dot: [f64; TERMS] = std::array::from_fn(|k| (k + 1) as f64 * s.xi[k + 1]);
-        let slip: [f64; TERMS] = std::array::from_fn(|k| {
-            (xi_dot[k] + p.r_M * s.omega_M[k]) * inv_r_L - if k == 0 { p.omega_S } else { 0.0 }
-        });
         for k in 0..TERMS {
             c[k][XI] = s.xi[k];
             c[k][XI_DOT] = xi_dot[k];
         }
+        // The rates' first TERMS − 1 coefficients, integrated term by term below.
+        const RATES: usize = TERMS - 1;
+        let xi_dot: [f64; RATES] = std::array::from_fn(|k| xi_dot[k]);
+        let slip: [f64; RATES] = std::array::from_fn(|k| {
+            (xi_dot[k] + p.r_M * s.omega_M[k]) * inv_r_L - if k == 0 { p.omega_S } else { 0.0 }
+        });
+        let force: [f64; RATES] = std::array::from_fn(|k| s.force[k]);
+        let omega_M: [f64; RATES] = std::array::from_fn(|k| s.omega_M[k]);
+        let contact = math::series_product(&xi_dot, &xi_dot);
+        let lubricant = math::series_product(&slip, &slip);
+        let shaft = math::series_product(&force, &omega_M);
         c[0][E_CONTACT] = y[E_CONTACT];
         c[0][E_LUBRICANT] = y[E_LUBRICANT];
         c[0][W_SHAFT] = y[W_SHAFT];
         for (k, row) in c.iter_mut().enumerate().skip(1) {
             // The coefficient k − 1 of each rate, integrated: / k.
-            let inv_k = 1.0 / k as f64;
-            row[E_CONTACT] = p.C_LM * square(&xi_dot, k - 1) * inv_k;
-            row[E_LUBRICANT] = p.C * square(&slip, k - 1) * inv_k;
-            let force_omega: f64 = (0..k).map(|j| s.force[j] * s.omega_M[k - 1 - j]).sum();
-            row[W_SHAFT] = -p.r_M * force_omega * inv_k;
+            let inv_k = math::INVERSES[k];
+            row[E_CONTACT] = p.C_LM * contact[k - 1] * inv_k;
+            row[E_LUBRICANT] = p.C * lubricant[k - 1] * inv_k;
+            row[W_SHAFT] = -p.r_M * shaft[k - 1] * inv_k;
         }
         true
     }

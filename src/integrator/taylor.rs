@@ -52,7 +52,7 @@ impl<const N: usize> Step<N> {
             for k in [TERMS - 2, TERMS - 1] {
                 let ck = c[k][i].abs();
                 if ck > 0.0 {
-                    log_h = log_h.min((log_w - math::log2_coarse(ck)) / k as f64);
+                    log_h = log_h.min((log_w - math::log2_coarse(ck)) * math::INVERSES[k]);
                 }
             }
         }

@@ -174,6 +174,7 @@ impl Excitation {
     /// Taylor coefficients about t of ω_M and a_M, to M terms: for the sine, the k-th
     /// derivatives of ω̄ − A/w cos(wt) and A sin(wt) over k!; the polynomial's are exact.
     pub fn series<const M: usize>(&self, t: f64) -> ([f64; M], [f64; M]) {
+        const { assert!(M < crate::math::INVERSES.len()) };
         let (mut omega, mut alpha) = ([0.0; M], [0.0; M]);
         match self {
             Excitation::Sine(s) => {
@@ -185,7 +186,7 @@ impl Excitation {
                     let (sin_k, cos_k) = quarter[k % 4];
                     omega[k] = -s.a_over_w * scale * cos_k;
                     alpha[k] = s.amplitude * scale * sin_k;
-                    scale *= s.w / (k + 1) as f64;
+                    scale *= s.w * crate::math::INVERSES[k + 1];
                 }
                 omega[0] += s.omega_mean;
             }

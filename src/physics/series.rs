@@ -3,13 +3,15 @@
 //! δ|δ|^(α−1) at δ = 0, so the solution is analytic and its coefficients follow one from
 //! another:
 //!
-//! - u = |δ|/G > 0 and v = u^α: u v' = α u' v, hence k u₀ v_k = Σ_{j=1..k} (α j − (k − j)) u_j v_{k−j};
+//! - u = |δ|/G > 0 and v = u^α: u v' = α u' v, hence k u₀ v_k = Σ_{j=1..k} (α j − (k − j)) u_j v_{k−j}
+//!   = (α + 1) Σ j u_j v_{k−j} − k Σ u_j v_{k−j};
 //! - F_k = ±K* G v_k (the elastic force, + on F−) plus C_LM (k+1) ξ_{k+1};
 //! - ξ'' = (r_L B − r_L² F − C (ξ' + r_M ω_M − r_L ω_S)) / I_L − r_M a_M (MODEL.md §3 with
 //!   ω_L = (ξ' + r_M ω_M)/r_L) gives ξ_{k+2} = ξ''_k / ((k+1)(k+2)).
 #![allow(non_snake_case)]
 
 use super::{Dynamics, Excitation, Region};
+use crate::math::INVERSES;
 
 /// Coefficients about t of the motion in full contact: ξ and ω_M to M terms, F to M − 2 (the
 /// rest left 0), so that ξ' and the power flows come to M − 1 terms.
@@ -31,6 +33,7 @@ impl<const M: usize> ContactSeries<M> {
         xi: f64,
         xi_dot: f64,
     ) -> Option<Self> {
+        const { assert!(M < INVERSES.len()) };
         let p = &dynamics.params;
         // δ = σ G u: σ = −1 on F+ (δ = ξ), +1 on F− (δ = ξ − G).
         let (sigma, offset) = match region {
@@ -56,14 +59,16 @@ impl<const M: usize> ContactSeries<M> {
         // right-hand side gives.
         let elastic0 = dynamics.law.force(region, xi, xi_dot).elastic;
         let scale = sigma * p.K_star * p.G;
-        let (mut u, mut v) = ([0.0; M], [0.0; M]);
-        let (sigma_over_G, inv_u0) = (sigma / p.G, 1.0 / u0);
+        // ju_j = j u_j; no division on the terms' chain (INVERSES).
+        let (mut u, mut ju, mut v) = ([0.0; M], [0.0; M], [0.0; M]);
+        let (sigma_over_G, inv_u0, alpha_plus_1) = (sigma / p.G, 1.0 / u0, p.alpha + 1.0);
         u[0] = u0;
         v[0] = elastic0 / scale;
         for k in 0..M - 2 {
             if k > 0 {
                 u[k] = sigma_over_G * s.xi[k];
-                v[k] = power_term(p.alpha, &u, &v, k, inv_u0);
+                ju[k] = k as f64 * u[k];
+                v[k] = power_term(alpha_plus_1, &u, &ju, &v, k, inv_u0);
             }
             let rate = (k + 1) as f64 * s.xi[k + 1];
             s.force[k] = scale * v[k] + p.C_LM * rate;
@@ -72,21 +77,24 @@ impl<const M: usize> ContactSeries<M> {
             if k == 0 {
                 xi_ddot += constant;
             }
-            s.xi[k + 2] = xi_ddot / ((k + 1) * (k + 2)) as f64;
+            s.xi[k + 2] = xi_ddot * (INVERSES[k + 1] * INVERSES[k + 2]);
         }
         Some(s)
     }
 }
 
-/// The term k ≥ 1 of v = u^a from u's terms 0..=k and v's 0..k (1/u₀ given):
-/// k u₀ v_k = Σ_{j=1..k} (a j − (k − j)) u_j v_{k−j}, from u v' = a u' v.
+/// The term k ≥ 1 of v = u^a from u's terms 0..=k (and j u_j) and v's 0..k, given a + 1 and
+/// 1/u₀: v_k = ((a + 1)/k Σ_{j=1..k} j u_j v_{k−j} − Σ_{j=1..k} u_j v_{k−j}) / u₀, from
+/// u v' = a u' v; two independent sums of products, no division. The sums take v_{k−1}, the
+/// newest term, last, so that they run while it is still being formed.
 #[inline]
-fn power_term(a: f64, u: &[f64], v: &[f64], k: usize, inv_u0: f64) -> f64 {
-    let mut acc = 0.0;
-    for j in 1..=k {
-        acc += (a * j as f64 - (k - j) as f64) * u[j] * v[k - j];
+fn power_term(a_plus_1: f64, u: &[f64], ju: &[f64], v: &[f64], k: usize, inv_u0: f64) -> f64 {
+    let (mut weighted, mut plain) = (0.0, 0.0);
+    for j in (1..=k).rev() {
+        weighted += ju[j] * v[k - j];
+        plain += u[j] * v[k - j];
     }
-    acc * inv_u0 / k as f64
+    (a_plus_1 * INVERSES[k] * weighted - plain) * inv_u0
 }
 
 #[cfg(test)]
@@ -99,11 +107,12 @@ mod tests {
     fn power_terms_are_binomial() {
         for a in [4.0 / 3.0, 1.5, 1.0, 10.0 / 9.0] {
             let u = [2.0, 3.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0];
+            let ju: [f64; 12] = std::array::from_fn(|j| j as f64 * u[j]);
             let mut v = [0.0; 12];
             v[0] = 2f64.powf(a);
             let mut binomial = v[0];
             for k in 1..12 {
-                v[k] = power_term(a, &u, &v, k, 0.5);
+                v[k] = power_term(a + 1.0, &u, &ju, &v, k, 0.5);
                 binomial *= (a - (k - 1) as f64) / k as f64 * 1.5;
                 assert!(
                     (v[k] - binomial).abs() <= 1e-14 * binomial.abs().max(1e-3),
