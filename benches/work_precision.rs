@@ -1,6 +1,8 @@
 //! Work-precision benchmark of issue 3: error against CPU time for the GearRattle integrator
 //! called directly, the FMU through its C API, and maintained Rust ODE crates on the same
-//! equations, measured side by side (interleaved repeats) in one run.
+//! equations, measured side by side (interleaved repeats) in one run. On S1 the integrators
+//! then run once more side by side, each at the tolerance where its error is within 1e-9 m
+//! (suite `rust-equal-error` of the CSV): the targets' ratios measured, not interpolated.
 //!
 //!     cargo bench -p gear_rattle_bench --bench work_precision          (or `make bench`, which runs everything)
 //!
@@ -52,6 +54,13 @@ const COMM_STEPS: [f64; 4] = [1e-2, 1e-3, 1e-4, 1e-5];
 const GRID: f64 = 1e-3;
 /// Error level at which solvers are compared (issue 3: 1e-9 m = 4e-5 G on S1).
 const TARGET_ERROR: f64 = 1e-9;
+/// Scenes where the integrators also run side by side at equal error (each at the tolerance
+/// that brings its error within [`TARGET_ERROR`]), with this budget of CPU seconds and at most
+/// this many repeats: the ratios of the targets without an interpolation across groups run
+/// minutes apart.
+const EQUAL_ERROR_SCENES: [&str; 2] = ["S1-0.2s", "S1-1s"];
+const EQUAL_ERROR_BUDGET: f64 = 4.0;
+const EQUAL_ERROR_REPS: usize = 41;
 /// The peers with GearRattle's RHS and event handling (an integrator comparison)...
 const PEERS_SAME_RHS: [&str; 3] = [
     "differential-equations DOPRI5",
@@ -479,6 +488,39 @@ struct Config<'a> {
     runner: Box<dyn FnMut() -> Outcome + 'a>,
 }
 
+/// The integrators at `rtol`: GearRattle, then each crate with GearRattle's RHS and event
+/// handling, then each crate as a user writes it from MODEL.md.
+fn integrators(sc: &Scene, rtol: f64) -> Vec<Config<'_>> {
+    let mut configs = vec![Config {
+        solver: "GearRattle (direct)",
+        comm: None,
+        rtol,
+        runner: Box::new(move || run_gearrattle(sc, rtol)),
+    }];
+    for (user, names) in [(false, PEERS_SAME_RHS), (true, PEERS_USER_RHS)] {
+        let [dopri5, dop853, tsit45] = names;
+        configs.push(Config {
+            solver: dopri5,
+            comm: None,
+            rtol,
+            runner: Box::new(move || run_de(sc, rtol, DeMethod::Dopri5, user)),
+        });
+        configs.push(Config {
+            solver: dop853,
+            comm: None,
+            rtol,
+            runner: Box::new(move || run_de(sc, rtol, DeMethod::Dop853, user)),
+        });
+        configs.push(Config {
+            solver: tsit45,
+            comm: None,
+            rtol,
+            runner: Box::new(move || run_tsit45(sc, rtol, user)),
+        });
+    }
+    configs
+}
+
 struct Measured {
     solver: &'static str,
     comm: Option<f64>,
@@ -573,10 +615,10 @@ const HEADER: &str = "suite,solver,scene,t_end,window,rtol,comm_step,err_max_xi,
 cpu_median,cpu_min,cpu_max,repeats,rhs_evals,steps,edges,impacts_plus,impacts_minus,\
 rate_plus,rate_minus,status";
 
-fn csv_row(sc: &Scene, r: &Reference, m: &Measured) -> String {
+fn csv_row(suite: &str, sc: &Scene, r: &Reference, m: &Measured) -> String {
     let comm = m.comm.map_or(String::new(), |c| format!("{c:e}"));
     let mut line = format!(
-        "rust,{},{},{},{},{:e},{}",
+        "{suite},{},{},{},{},{:e},{}",
         m.solver, sc.name, sc.t_end, sc.window, m.rtol, comm
     );
     match &m.first {
@@ -636,10 +678,11 @@ fn csv_row(sc: &Scene, r: &Reference, m: &Measured) -> String {
 // Equal-error comparison (the targets of issue 3 are at 1e-9 m on S1)
 // ---------------------------------------------------------------------------------------
 
-/// CPU time at error `target`, interpolated log-log between the two tolerances of the sweep
-/// that bracket it; None if the solver never reaches it. The bool says "interpolated" (false:
-/// already below at the loosest tolerance, the cost there is an upper bound).
-fn cost_at(points: &[(f64, f64)], target: f64) -> Option<(f64, bool)> {
+/// The value (CPU time, or tolerance) at error `target`, interpolated log-log between the two
+/// tolerances of the sweep (loosest first) that bracket it; None if the solver never reaches
+/// it. The bool says "interpolated" (false: already below at the loosest tolerance, the
+/// value there is a bound).
+fn at_error(points: &[(f64, f64)], target: f64) -> Option<(f64, bool)> {
     let i = points.iter().position(|&(e, _)| e <= target)?;
     if i == 0 {
         return Some((points[0].1, false));
@@ -648,6 +691,78 @@ fn cost_at(points: &[(f64, f64)], target: f64) -> Option<(f64, bool)> {
     let (e1, c1) = points[i];
     let w = (target.ln() - e0.ln()) / (e1.ln() - e0.ln());
     Some(((c0.ln() + w * (c1.ln() - c0.ln())).exp(), true))
+}
+
+/// Each integrator at the loosest tolerance found where its error on `sc` is at most
+/// [`TARGET_ERROR`], for a group run side by side: bisection (in log rtol, 6 runs) between
+/// the two tolerances of the sweep that bracket the target, keeping the side within it, so
+/// that every solver ends within 2 % in rtol of its own threshold. Solvers that never reach
+/// it are left out; one already within it at the loosest tolerance runs there.
+fn equal_error_configs<'a>(sc: &'a Scene, r: &Reference, sweep: &[Measured]) -> Vec<Config<'a>> {
+    let solvers: Vec<&'static str> = integrators(sc, 1.0).iter().map(|c| c.solver).collect();
+    let error_at = |solver: &str, rtol: f64| -> Option<f64> {
+        let mut config = integrators(sc, rtol)
+            .into_iter()
+            .find(|c| c.solver == solver)?;
+        let (s, _) = (config.runner)().ok()?;
+        Some(errors(&s, r, sc.window).max_xi)
+    };
+    solvers
+        .into_iter()
+        .filter_map(|solver| {
+            let points: Vec<(f64, f64)> = sweep
+                .iter()
+                .filter(|m| m.solver == solver)
+                .filter_map(|m| {
+                    let s = m.first.as_ref().ok()?;
+                    Some((errors(s, r, sc.window).max_xi, m.rtol))
+                })
+                .collect();
+            let i = points.iter().position(|&(e, _)| e <= TARGET_ERROR)?;
+            let mut within = points[i].1;
+            if i > 0 {
+                let mut beyond = points[i - 1].1;
+                for _ in 0..6 {
+                    let mid = (within * beyond).sqrt();
+                    if error_at(solver, mid).is_some_and(|e| e <= TARGET_ERROR) {
+                        within = mid;
+                    } else {
+                        beyond = mid;
+                    }
+                }
+            }
+            integrators(sc, within)
+                .into_iter()
+                .find(|c| c.solver == solver)
+        })
+        .collect()
+}
+
+/// Prints the side-by-side group's ratios: the fastest crate of each kind over GearRattle.
+fn side_by_side(sc: &Scene, measured: &[Measured]) {
+    let cpu = |name: &str| {
+        measured
+            .iter()
+            .find(|m| m.solver == name && m.first.is_ok())
+            .map(|m| median(&m.cpu))
+    };
+    let Some(gr) = cpu("GearRattle (direct)") else {
+        return;
+    };
+    for (kind, names) in [
+        ("GearRattle's RHS and edge handling", PEERS_SAME_RHS),
+        ("user's RHS from MODEL.md", PEERS_USER_RHS),
+    ] {
+        let best = names
+            .iter()
+            .filter_map(|n| cpu(n))
+            .fold(f64::INFINITY, f64::min);
+        println!(
+            "{}: side by side at max |dxi| <= {TARGET_ERROR:e} m, fastest crate ({kind}) / GearRattle: {:.2}x (target >= 3)",
+            sc.name,
+            best / gr
+        );
+    }
 }
 
 fn main() {
@@ -732,41 +847,14 @@ fn main() {
     let wall = std::time::Instant::now();
     for sc in &scenes {
         let reference = load_reference(&ref_dir, &sc.base);
+        let mut sweep = Vec::new();
         for &rtol in &tols {
             // The integrators, side by side: GearRattle, then each crate with GearRattle's RHS
             // and event handling, then each crate as a user writes it from MODEL.md.
-            let mut configs = vec![Config {
-                solver: "GearRattle (direct)",
-                comm: None,
-                rtol,
-                runner: Box::new(|| run_gearrattle(sc, rtol)),
-            }];
-            for (user, names) in [(false, PEERS_SAME_RHS), (true, PEERS_USER_RHS)] {
-                let [dopri5, dop853, tsit45] = names;
-                configs.push(Config {
-                    solver: dopri5,
-                    comm: None,
-                    rtol,
-                    runner: Box::new(move || run_de(sc, rtol, DeMethod::Dopri5, user)),
-                });
-                configs.push(Config {
-                    solver: dop853,
-                    comm: None,
-                    rtol,
-                    runner: Box::new(move || run_de(sc, rtol, DeMethod::Dop853, user)),
-                });
-                configs.push(Config {
-                    solver: tsit45,
-                    comm: None,
-                    rtol,
-                    runner: Box::new(move || run_tsit45(sc, rtol, user)),
-                });
-            }
+            let configs = integrators(sc, rtol);
             let measured = measure(configs, budget, max_reps);
-            report(sc, &reference, &measured, &mut lines);
-            if sc.name == "S1-1s" {
-                s1.extend(measured);
-            }
+            report("rust", sc, &reference, &measured, &mut lines);
+            sweep.extend(measured);
             if !fmu_tolerance(rtol) {
                 continue;
             }
@@ -788,10 +876,19 @@ fn main() {
                 });
             }
             let measured_fmu = measure(configs, budget, max_reps);
-            report(sc, &reference, &measured_fmu, &mut lines);
+            report("rust", sc, &reference, &measured_fmu, &mut lines);
             if sc.name == "S1-1s" {
                 s1.extend(measured_fmu);
             }
+        }
+        if !quick && EQUAL_ERROR_SCENES.contains(&sc.name.as_str()) {
+            let configs = equal_error_configs(sc, &reference, &sweep);
+            let measured = measure(configs, EQUAL_ERROR_BUDGET, EQUAL_ERROR_REPS);
+            report("rust-equal-error", sc, &reference, &measured, &mut lines);
+            side_by_side(sc, &measured);
+        }
+        if sc.name == "S1-1s" {
+            s1.extend(sweep);
         }
     }
     if let Some(dir) = out_path.parent() {
@@ -807,9 +904,9 @@ fn main() {
     summary(&scenes, &ref_dir, &s1);
 }
 
-fn report(sc: &Scene, r: &Reference, measured: &[Measured], lines: &mut Vec<String>) {
+fn report(suite: &str, sc: &Scene, r: &Reference, measured: &[Measured], lines: &mut Vec<String>) {
     for m in measured {
-        lines.push(csv_row(sc, r, m));
+        lines.push(csv_row(suite, sc, r, m));
         let comm = m.comm.map_or(String::new(), |c| format!(" @{c:e} s"));
         match &m.first {
             Ok(s) => {
@@ -851,7 +948,7 @@ fn summary(scenes: &[Scene], ref_dir: &Path, s1: &[Measured]) {
             .collect()
     };
     println!("\nS1 (1 s): CPU time at max |dxi| = {TARGET_ERROR:e} m (log-log interpolation):");
-    let gr = cost_at(&curve("GearRattle (direct)", None), TARGET_ERROR);
+    let gr = at_error(&curve("GearRattle (direct)", None), TARGET_ERROR);
     let show = |n: &str, c: Option<(f64, bool)>| match c {
         Some((c, exact)) => println!(
             "  {n:44} {c:.3e} s{}",
@@ -866,7 +963,7 @@ fn summary(scenes: &[Scene], ref_dir: &Path, s1: &[Measured]) {
     ] {
         let costs: Vec<Option<(f64, bool)>> = names
             .iter()
-            .map(|n| cost_at(&curve(n, None), TARGET_ERROR))
+            .map(|n| at_error(&curve(n, None), TARGET_ERROR))
             .collect();
         for (n, c) in names.iter().zip(&costs) {
             show(n, *c);
