@@ -394,6 +394,36 @@ mod tests {
         }
     }
 
+    /// e^x · e^(2x) = e^(3x): the product of the series 1/k! and 2^k/k! has the terms 3^k/k!,
+    /// each within 1e-14 (a sum of k + 1 positive products); and 1/k from the table is the
+    /// division's.
+    #[test]
+    fn series_product_of_exponentials() {
+        const K: usize = 12;
+        let mut factorial = 1.0;
+        let (mut a, mut b, mut expected) = ([0.0; K], [0.0; K], [0.0; K]);
+        for k in 0..K {
+            if k > 0 {
+                factorial *= k as f64;
+            }
+            a[k] = 1.0 / factorial;
+            b[k] = 2f64.powi(k as i32) / factorial;
+            expected[k] = 3f64.powi(k as i32) / factorial;
+        }
+        let p = series_product(&a, &b);
+        for k in 0..K {
+            assert!(
+                (p[k] - expected[k]).abs() <= 1e-14 * expected[k],
+                "k {k}: {} vs {}",
+                p[k],
+                expected[k]
+            );
+        }
+        for (k, inverse) in INVERSES.iter().enumerate().skip(1) {
+            assert_eq!(*inverse, 1.0 / k as f64);
+        }
+    }
+
     /// sin_squared against std's sin, squared, over 1e6 arguments uniform in [−π/2, π/2]
     /// and the ends: within 6e-16 absolute.
     #[test]
