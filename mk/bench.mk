@@ -1,6 +1,7 @@
 # Work-precision benchmark (issue 3): `make bench` measures GearRattle beside its peers and
 # regenerates docs/BENCHMARKS.md and docs/work_precision.png. Not part of `make test`: it
-# takes about half an hour on the 2-core machine and makes no timed assertion.
+# takes 12-16 min on the 2-core machine (about 8 more when the reference is rebuilt) and makes
+# no timed assertion.
 #
 #   make bench            everything (reference only when missing or outdated)
 #   make bench-reference  the independent reference alone (scripts/bench_reference.py)
