@@ -384,12 +384,20 @@ impl<const N: usize> Solver<N> {
                 self.h = self.initial_step(sys, *t, y, &k1, h_max);
             }
             // The first DOPRI5 step into a piece just entered starts from what was learnt of
-            // that piece's entries.
+            // that piece's entries, as a ratio to a base: the time to cross the piece at the
+            // guard's rate where the piece is bounded (a band: ε/|ξ'|, whatever step the
+            // free flight or the contact before it left), else the step carried over the edge.
             let entering = match self.entering.take() {
                 Some(entry) if !self.implicit => {
-                    let carried = self.h;
-                    self.h *= self.entries.ratio(&entry);
-                    Some((entry, carried))
+                    let rate = y[S::RATE].abs();
+                    let width = entry.hi - entry.lo;
+                    let base = if width.is_finite() && rate > 0.0 {
+                        width / rate
+                    } else {
+                        self.h
+                    };
+                    self.h = base * self.entries.ratio(&entry);
+                    Some((entry, base))
                 }
                 _ => None,
             };
