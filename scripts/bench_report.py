@@ -331,7 +331,10 @@ def analysis(rows, s1, r_rust, n_rust, r_user, n_user, r_py, n_py, comm_rows, to
               "cube root, the excitation's sine and cosine by fdlibm's kernels, inlined, the band's sin² as a polynomial, no powf for "
               "α = 4/3); no allocation on the stepping path (each DOPRI5 step written in place); the stages form "
               "only ξ and ξ' (the energy quadratures advance at the step's end); the first step into a piece "
-              "starts from what the earlier entries into it taught the step-size controller (`entries`); the step-size controller's "
+              "is sized from the piece's crossing time (a band: ε/|ξ'|, where the step carried over the edge had "
+              "left S1's error at loose tolerances several-fold higher: the bands' non-smooth starts are where "
+              "it comes from) times what the earlier entries into it taught the step-size controller "
+              "(`entries`); the step-size controller's "
               "powers by a coarse log2/exp2; the free flight's start computed once per passage; no division on "
               "the path of a stage or of a flight's point (1/r_L, 1/I_L, A/w, A/w², 1/λ kept); outputs computed "
               "only when read. What is left, with the most each could give here (the share it could remove, as "
@@ -399,10 +402,7 @@ def analysis(rows, s1, r_rust, n_rust, r_user, n_user, r_py, n_py, comm_rows, to
                   "share of the error weights for the Taylor steps' truncation, SHARE 0.01 (the error at each "
                   "tolerance fell by about a tenth only, so on S1 it comes mostly from the bands' DOPRI5 steps; "
                   "slower at equal error); crossing a band → contact edge at the straddling step's dense output, where a "
-                  "Taylor step follows (the errors 2.5× higher at each tolerance, no gain at equal error). The first "
-                  "DOPRI5 step into a band sized from the band's crossing time ε/|ξ'| instead of the step carried "
-                  "over the edge lowered S1's error at loose tolerances several-fold (so that error comes from the "
-                  "bands' first steps, where the solution starts non-smooth) and is the next lever to measure here.")
+                  "Taylor step follows (the errors 2.5× higher at each tolerance, no gain at equal error).")
                 a("")
     if comm_rows:
         key = [cr for cr in comm_rows if tol_1e9 and math.isclose(cr[0], tol_1e9)] or comm_rows[:1]
