@@ -1,4 +1,5 @@
-//! Error norm and step-size control of DOPRI5 (Hairer's PI controller, β = 0.04).
+//! Error norm and step-size control of DOPRI5: Hairer's PI controller (β = 0.04), capped by
+//! Gustafsson's predictive controller.
 
 use serde::{Deserialize, Serialize};
 
@@ -35,6 +36,11 @@ const EXPONENT: f64 = 0.2 - BETA * 0.75;
 /// Largest shrink (1/10) and growth (×5) of the step per step.
 const MIN_FACTOR: f64 = 0.1;
 const MAX_FACTOR: f64 = 5.0;
+/// 1/(q + 1) for the embedded estimate's order q = 4: the exponent of Gustafsson's
+/// predictive step (Hairer & Wanner, Solving ODEs II, IV.8, as in RADAU5).
+const PREDICTIVE_EXPONENT: f64 = 0.2;
+/// Floor of the previous error in the predictive step (RADAU5's).
+const PREDICTIVE_FLOOR: f64 = 1e-2;
 
 /// Verdict on a step with its weighted error: accept or not, and the next step size.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -43,11 +49,26 @@ pub struct Verdict {
     pub h_next: f64,
 }
 
-/// PI step-size controller; its memory (the previous error) is part of the solver's state.
+/// PI step-size controller capped by Gustafsson's predictive one; its memory (the previous
+/// error, the last accepted step) is part of the solver's state.
+///
+/// The predictive step h²/h_acc · SAFETY · (err_acc / err²)^(1/5) extrapolates the trend of
+/// the error from one accepted step to the next, where the PI step only reads the error
+/// level. Through a smoothing band the contact stiffens with every step, so steps the PI
+/// controller grew were rejected: on S1 (1 s) 462 rejections against 3 965 accepted steps at
+/// rtol 3.95e-6, 185 against 3 661 at 1.09e-5 with the cap. The error fell with them: the
+/// loosest rtol from which every tolerance tighter on a grid of ratio 1.22 reaches 1e-9 m went
+/// from 4.0e-6 (17 481 RHS) to 7.3e-6 (15 837 RHS), 7-9 % less CPU at that error, measured
+/// in alternation (`BENCH_DEBUG=gr` and `BENCH_PROFILE=1` of the work-precision bench).
+/// The last accepted step is kept across edges: the first step into a band is then capped
+/// by how the previous band's last step went; forgetting it there gave no gain.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Controller {
     previous_error: f64,
     rejected_last: bool,
+    /// The last accepted step and log2 of its error (floored); h_acc = 0 before the first.
+    h_acc: f64,
+    log_err_acc: f64,
 }
 
 impl Default for Controller {
@@ -55,6 +76,8 @@ impl Default for Controller {
         Controller {
             previous_error: 1e-4,
             rejected_last: false,
+            h_acc: 0.0,
+            log_err_acc: 0.0,
         }
     }
 }
@@ -77,6 +100,14 @@ impl Controller {
             let growth = (SAFETY * math::exp2_coarse(BETA * log_previous - EXPONENT * log_err))
                 .clamp(MIN_FACTOR, MAX_FACTOR);
             let mut h_next = h * growth;
+            if self.h_acc > 0.0 {
+                let trend =
+                    math::exp2_coarse(PREDICTIVE_EXPONENT * (self.log_err_acc - 2.0 * log_err));
+                let predicted = h * (h / self.h_acc) * SAFETY * trend;
+                h_next = h_next.min(predicted.clamp(h * MIN_FACTOR, h * MAX_FACTOR));
+            }
+            self.h_acc = h;
+            self.log_err_acc = math::log2_coarse(err.max(PREDICTIVE_FLOOR));
             if self.rejected_last {
                 h_next = h_next.min(h);
             }
