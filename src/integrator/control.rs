@@ -126,3 +126,38 @@ impl Controller {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// PI step factor SAFETY · previous^β / err^(1/5 − 0.75β), computed with powf.
+    fn pi_factor(previous: f64, err: f64) -> f64 {
+        SAFETY * previous.powf(BETA) / err.powf(EXPONENT)
+    }
+
+    /// After two accepted steps of equal size, an error rising from 0.1 to 0.5 (a contact
+    /// stiffening) gives the predictive step SAFETY · (0.1 / 0.5²)^(1/5), shorter than the PI
+    /// step; an error falling from 0.5 to 0.1 gives the PI step, the predictive one (longer)
+    /// only capping it. The coarse log2/exp2 hold both within 1e-3.
+    #[test]
+    fn a_rising_error_is_foreseen_a_falling_one_left_to_the_pi_step() {
+        let h = 1e-5;
+        let mut rising = Controller::default();
+        assert!(rising.judge(0.1, h).accept);
+        let next = rising.judge(0.5, h).h_next / h;
+        let predictive = SAFETY * (0.1_f64 / 0.25).powf(0.2);
+        assert!(predictive < pi_factor(0.1, 0.5));
+        assert!(
+            (next - predictive).abs() < 1e-3 * predictive,
+            "{next} vs {predictive}"
+        );
+
+        let mut falling = Controller::default();
+        assert!(falling.judge(0.5, h).accept);
+        let next = falling.judge(0.1, h).h_next / h;
+        let pi = pi_factor(0.5, 0.1);
+        assert!(pi < SAFETY * (0.5_f64 / 0.01).powf(0.2));
+        assert!((next - pi).abs() < 1e-3 * pi, "{next} vs {pi}");
+    }
+}
