@@ -598,8 +598,8 @@ def main() -> None:
     if sbs:
         w("## Headline (S1, 1 s, side by side at equal error max |Δξ| ≤ 1e-9 m = 4e-5·G)")
         w("")
-        w("Each integrator at the loosest tolerance found where its error is within 1e-9 m there and at 1.5 and "
-          "2.25 times tighter, then all run round-robin in one group, repeat after repeat: the ratios come from "
+        w("Each integrator at the loosest tolerance found where its error is within 1e-9 m there and at 1.22, "
+          "1.5, 1.83 and 2.25 times tighter, then all run round-robin in one group, repeat after repeat: the ratios come from "
           "one stretch of time on this noisy machine, with no interpolation between groups run minutes apart. "
           "The tighter probes are there because errors are not monotone in the tolerance: GearRattle's on S1 1 s "
           "was 3.1e-10 m at rtol 1e-5 but 1.5e-9 m at 8e-6 and 5e-6 and 2.0e-9 m at 1.2e-5 (on 7d5bb2d, "
