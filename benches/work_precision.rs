@@ -702,11 +702,11 @@ fn at_error(points: &[(f64, f64)], target: f64) -> Option<(f64, bool)> {
 /// [`TARGET_ERROR`] there and at the tolerances [`PROBES`] times tighter, for a group run side
 /// by side. Errors are not monotone in the tolerance: GearRattle's on S1 1 s was 3.1e-10 m at
 /// rtol 1e-5 but 1.5e-9 m at 8e-6 and 5e-6 (on 7d5bb2d), and a tolerance that falls in such a
-/// dip is one a user could not choose without the reference in hand. The loosest tolerance of the sweep
-/// that passes this test, then bisection (in log rtol, 6 steps) towards the sweep's next
-/// looser tolerance, so that every solver ends within 2 % in rtol of its own threshold.
-/// Solvers that never reach it are left out; one within it at the loosest tolerance runs
-/// there.
+/// dip is one a user could not choose without the reference in hand. The loosest tolerance
+/// of the sweep that passes this test, then bisection (in log rtol, 6 steps) towards the
+/// sweep's next looser tolerance, so that every solver ends within 2 % in rtol of its own
+/// threshold. Solvers that never reach it are left out; one within it at the loosest
+/// tolerance runs there.
 fn equal_error_configs<'a>(sc: &'a Scene, r: &Reference, sweep: &[Measured]) -> Vec<Config<'a>> {
     let solvers: Vec<&'static str> = integrators(sc, 1.0).iter().map(|c| c.solver).collect();
     let error_at = |solver: &str, rtol: f64| -> Option<f64> {
