@@ -108,7 +108,11 @@ impl Controller {
                 h_next = h_next.min(predicted.clamp(h * MIN_FACTOR, h * MAX_FACTOR));
             }
             self.h_acc = h;
-            self.log_err_acc = math::log2_coarse(err.max(PREDICTIVE_FLOOR));
+            self.log_err_acc = if err > PREDICTIVE_FLOOR {
+                log_err
+            } else {
+                math::log2_coarse(PREDICTIVE_FLOOR)
+            };
             if self.rejected_last {
                 h_next = h_next.min(h);
             }
