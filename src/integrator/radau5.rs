@@ -204,6 +204,52 @@ impl<const N: usize> Factors<N> {
             complex: Lu::new(e2)?,
         })
     }
+
+    /// The increment ΔW of one simplified Newton iteration in the transformed variables
+    /// W = T⁻¹ Z (Hairer & Wanner, IV.8), from the stages' values F_s = f(t + c_s h, y0 + Z_s):
+    /// ((γ/h) I − J) ΔW₁ = (T⁻¹F)₁ − (γ/h) W₁ and, for ΔW₂ + iΔW₃, the complex system with
+    /// (α + iβ)/h. `scaled` is (γ/h, α/h, β/h) for this h.
+    #[inline]
+    fn newton_increment(
+        &self,
+        f: &[[f64; N]; 3],
+        w: &[[f64; N]; 3],
+        (fac1, alphn, betan): (f64, f64, f64),
+    ) -> ([f64; N], [Complex<f64>; N]) {
+        let mut r1 = [0.0; N];
+        let mut r23 = [Complex::new(0.0, 0.0); N];
+        for i in 0..N {
+            let (a1, a2, a3) = (f[0][i], f[1][i], f[2][i]);
+            r1[i] = TI11 * a1 + TI12 * a2 + TI13 * a3 - fac1 * w[0][i];
+            r23[i] = Complex::new(
+                TI21 * a1 + TI22 * a2 + TI23 * a3 - alphn * w[1][i] + betan * w[2][i],
+                TI31 * a1 + TI32 * a2 + TI33 * a3 - alphn * w[2][i] - betan * w[1][i],
+            );
+        }
+        self.real.solve(&mut r1);
+        self.complex.solve(&mut r23);
+        (r1, r23)
+    }
+}
+
+/// W += ΔW (the real system's part and the complex one's) and Z = T W, the stages'
+/// increments Z_s = y_s − y0.
+#[inline]
+fn apply_increment<const N: usize>(
+    w: &mut [[f64; N]; 3],
+    z: &mut [[f64; N]; 3],
+    r1: &[f64; N],
+    r23: &[Complex<f64>; N],
+) {
+    for i in 0..N {
+        w[0][i] += r1[i];
+        w[1][i] += r23[i].re;
+        w[2][i] += r23[i].im;
+        let (w1, w2, w3) = (w[0][i], w[1][i], w[2][i]);
+        z[0][i] = T11 * w1 + T12 * w2 + T13 * w3;
+        z[1][i] = T21 * w1 + T22 * w2 + T23 * w3;
+        z[2][i] = T31 * w1 + w2;
+    }
 }
 
 /// The last accepted step: where it ended, its size and polynomial (starting values of the
@@ -399,18 +445,7 @@ impl<const N: usize> Stepper<N> {
             };
             let f = [stage(C1, &z[0]), stage(C2, &z[1]), stage(1.0, &z[2])];
             self.stats.rhs_evals += 3;
-            let mut r1 = [0.0; N];
-            let mut r23 = [Complex::new(0.0, 0.0); N];
-            for i in 0..N {
-                let (a1, a2, a3) = (f[0][i], f[1][i], f[2][i]);
-                r1[i] = TI11 * a1 + TI12 * a2 + TI13 * a3 - fac1 * w[0][i];
-                r23[i] = Complex::new(
-                    TI21 * a1 + TI22 * a2 + TI23 * a3 - alphn * w[1][i] + betan * w[2][i],
-                    TI31 * a1 + TI32 * a2 + TI33 * a3 - alphn * w[2][i] - betan * w[1][i],
-                );
-            }
-            factors.real.solve(&mut r1);
-            factors.complex.solve(&mut r23);
+            let (r1, r23) = factors.newton_increment(&f, &w, (fac1, alphn, betan));
             newt += 1;
             self.stats.newton_iterations += 1;
             let mut sum = 0.0;
@@ -444,15 +479,7 @@ impl<const N: usize> Stepper<N> {
                 }
             }
             dyno_old = dyno.max(UROUND);
-            for i in 0..N {
-                w[0][i] += r1[i];
-                w[1][i] += r23[i].re;
-                w[2][i] += r23[i].im;
-                let (w1, w2, w3) = (w[0][i], w[1][i], w[2][i]);
-                z[0][i] = T11 * w1 + T12 * w2 + T13 * w3;
-                z[1][i] = T21 * w1 + T22 * w2 + T23 * w3;
-                z[2][i] = T31 * w1 + w2;
-            }
+            apply_increment(&mut w, &mut z, &r1, &r23);
             if self.faccon * dyno <= self.fnewt {
                 break;
             }
@@ -614,6 +641,26 @@ impl<const N: usize> Stepper<N> {
     }
 }
 
+/// The Butcher matrix of the 3-stage Radau IIA method in closed form (Hairer & Wanner, IV.5),
+/// for the tests that check the constants and time the algebra.
+#[cfg(test)]
+fn butcher() -> [[f64; 3]; 3] {
+    let s6 = 6f64.sqrt();
+    [
+        [
+            (88.0 - 7.0 * s6) / 360.0,
+            (296.0 - 169.0 * s6) / 1800.0,
+            (-2.0 + 3.0 * s6) / 225.0,
+        ],
+        [
+            (296.0 + 169.0 * s6) / 1800.0,
+            (88.0 + 7.0 * s6) / 360.0,
+            (-2.0 - 3.0 * s6) / 225.0,
+        ],
+        [(16.0 - s6) / 36.0, (16.0 + s6) / 36.0, 1.0 / 9.0],
+    ]
+}
+
 #[cfg(test)]
 #[allow(clippy::needless_range_loop)]
 mod tests {
@@ -627,17 +674,8 @@ mod tests {
         assert!((DD1 + (13.0 + 7.0 * s6) / 3.0).abs() < 1e-14);
         assert!((DD2 - (-13.0 + 7.0 * s6) / 3.0).abs() < 1e-14);
         // Radau IIA, s = 3.
-        let a = nalgebra::Matrix3::new(
-            (88.0 - 7.0 * s6) / 360.0,
-            (296.0 - 169.0 * s6) / 1800.0,
-            (-2.0 + 3.0 * s6) / 225.0,
-            (296.0 + 169.0 * s6) / 1800.0,
-            (88.0 + 7.0 * s6) / 360.0,
-            (-2.0 - 3.0 * s6) / 225.0,
-            (16.0 - s6) / 36.0,
-            (16.0 + s6) / 36.0,
-            1.0 / 9.0,
-        );
+        let b = butcher();
+        let a = nalgebra::Matrix3::from_fn(|r, c| b[r][c]);
         let t = nalgebra::Matrix3::new(T11, T12, T13, T21, T22, T23, T31, 1.0, 0.0);
         let ti = nalgebra::Matrix3::new(TI11, TI12, TI13, TI21, TI22, TI23, TI31, TI32, TI33);
         assert!((t * ti - nalgebra::Matrix3::identity()).abs().max() < 1e-14);
@@ -733,23 +771,6 @@ mod measure {
     use std::hint::black_box;
     use std::time::Instant;
 
-    fn butcher() -> [[f64; 3]; 3] {
-        let s6 = 6f64.sqrt();
-        [
-            [
-                (88.0 - 7.0 * s6) / 360.0,
-                (296.0 - 169.0 * s6) / 1800.0,
-                (-2.0 + 3.0 * s6) / 225.0,
-            ],
-            [
-                (296.0 + 169.0 * s6) / 1800.0,
-                (88.0 + 7.0 * s6) / 360.0,
-                (-2.0 - 3.0 * s6) / 225.0,
-            ],
-            [(16.0 - s6) / 36.0, (16.0 + s6) / 36.0, 1.0 / 9.0],
-        ]
-    }
-
     fn random<const N: usize>(seed: &mut u64) -> [[f64; N]; N] {
         let mut j = [[0.0; N]; N];
         for row in j.iter_mut() {
@@ -803,27 +824,11 @@ mod measure {
             let mut z = [[0.0; N]; 3];
             let (fac1, alphn, betan) = (GAMMA / h, ALPHA / h, BETA / h);
             let it_t = time(reps, || {
-                let f = black_box(&f);
-                let mut r1 = [0.0; N];
-                let mut r23 = [Complex::new(0.0, 0.0); N];
-                for i in 0..N {
-                    let (a1, a2, a3) = (f[0][i], f[1][i], f[2][i]);
-                    r1[i] = TI11 * a1 + TI12 * a2 + TI13 * a3 - fac1 * w[0][i];
-                    r23[i] = Complex::new(
-                        TI21 * a1 + TI22 * a2 + TI23 * a3 - alphn * w[1][i] + betan * w[2][i],
-                        TI31 * a1 + TI32 * a2 + TI33 * a3 - alphn * w[2][i] - betan * w[1][i],
-                    );
-                }
-                fac.real.solve(&mut r1);
-                fac.complex.solve(&mut r23);
-                for i in 0..N {
-                    w[0][i] = 1e-3 * (w[0][i] + r1[i]);
-                    w[1][i] = 1e-3 * (w[1][i] + r23[i].re);
-                    w[2][i] = 1e-3 * (w[2][i] + r23[i].im);
-                    let (w1, w2, w3) = (w[0][i], w[1][i], w[2][i]);
-                    z[0][i] = T11 * w1 + T12 * w2 + T13 * w3;
-                    z[1][i] = T21 * w1 + T22 * w2 + T23 * w3;
-                    z[2][i] = T31 * w1 + w2;
+                let (r1, r23) = fac.newton_increment(black_box(&f), &w, (fac1, alphn, betan));
+                apply_increment(&mut w, &mut z, &r1, &r23);
+                // Kept bounded over the repetitions.
+                for v in w.iter_mut().flatten() {
+                    *v *= 1e-3;
                 }
                 black_box(&z);
             });
@@ -843,10 +848,7 @@ mod measure {
                 black_box(Lu::new(black_box(e1)));
             });
             // Full: one Newton iteration (residual −Z + h (A⊗I) F, one 3N solve, Z += ΔZ).
-            let lu = Lu::<f64, $n3>::new(full).unwrap();
-            let mut zf = [0.0; $n3];
-            let it_f = time(reps, || {
-                let f = black_box(&f);
+            let residual = |zf: &[f64; $n3], f: &[[f64; N]; 3]| {
                 let mut g = [0.0; $n3];
                 for s in 0..3 {
                     for i in 0..N {
@@ -854,6 +856,12 @@ mod measure {
                             + h * (a[s][0] * f[0][i] + a[s][1] * f[1][i] + a[s][2] * f[2][i]);
                     }
                 }
+                g
+            };
+            let lu = Lu::<f64, $n3>::new(full).unwrap();
+            let mut zf = [0.0; $n3];
+            let it_f = time(reps, || {
+                let mut g = residual(&zf, black_box(&f));
                 lu.solve(&mut g);
                 for k in 0..$n3 {
                     zf[k] = 1e-3 * (zf[k] + g[k]);
@@ -862,14 +870,7 @@ mod measure {
             });
             let lu_n = LU::new(full);
             let it_f_nalgebra = time(reps, || {
-                let f = black_box(&f);
-                let mut g = SVector::<f64, $n3>::zeros();
-                for s in 0..3 {
-                    for i in 0..N {
-                        g[s * N + i] = -zf[s * N + i]
-                            + h * (a[s][0] * f[0][i] + a[s][1] * f[1][i] + a[s][2] * f[2][i]);
-                    }
-                }
+                let mut g = SVector::<f64, $n3>::from(residual(&zf, black_box(&f)));
                 lu_n.solve_mut(&mut g);
                 for k in 0..$n3 {
                     zf[k] = 1e-3 * (zf[k] + g[k]);
