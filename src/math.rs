@@ -260,7 +260,7 @@ pub fn sin_squared(x: f64) -> f64 {
 /// not matter but latency does: the next step waits for the factor, and two `f64::powf`
 /// were slower on S1 (measured by A/B runs of the benchmark's profile). Zero gives −1025.
 #[inline]
-pub fn log2_coarse(x: f64) -> f64 {
+pub const fn log2_coarse(x: f64) -> f64 {
     const C: [f64; 4] = [
         -2.144_960_694_619_865_4,
         3.029_512_035_753_271,

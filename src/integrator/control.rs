@@ -39,8 +39,12 @@ const MAX_FACTOR: f64 = 5.0;
 /// 1/(q + 1) for the embedded estimate's order q = 4: the exponent of Gustafsson's
 /// predictive step (Hairer & Wanner, Solving ODEs II, IV.8, as in RADAU5).
 const PREDICTIVE_EXPONENT: f64 = 0.2;
-/// Floor of the previous error in the predictive step (RADAU5's).
+/// Floors of the last accepted error: 1e-4 in the PI step (Hairer's), 1e-2 in the
+/// predictive one (RADAU5's), with their log2.
+const PI_FLOOR: f64 = 1e-4;
 const PREDICTIVE_FLOOR: f64 = 1e-2;
+const LOG2_PI_FLOOR: f64 = math::log2_coarse(PI_FLOOR);
+const LOG2_PREDICTIVE_FLOOR: f64 = math::log2_coarse(PREDICTIVE_FLOOR);
 
 /// Verdict on a step with its weighted error: accept or not, and the next step size.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -65,25 +69,37 @@ pub struct Verdict {
 /// by how the previous band's last step went; forgetting it there gave no gain.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Controller {
-    previous_error: f64,
-    rejected_last: bool,
-    /// The last accepted step and log2 of its error (floored); h_acc = 0 before the first.
-    h_acc: f64,
+    /// The last accepted step's error and its log2, which both controllers read, each with
+    /// its own floor (the PI floor before the first step).
+    err_acc: f64,
     log_err_acc: f64,
+    rejected_last: bool,
+    /// The last accepted step; 0 before the first.
+    h_acc: f64,
 }
 
 impl Default for Controller {
     fn default() -> Self {
         Controller {
-            previous_error: 1e-4,
+            err_acc: PI_FLOOR,
+            log_err_acc: LOG2_PI_FLOOR,
             rejected_last: false,
             h_acc: 0.0,
-            log_err_acc: 0.0,
         }
     }
 }
 
 impl Controller {
+    /// log2 of the last accepted error floored at `floor` (whose log2 is `log2_floor`).
+    #[inline]
+    fn floored(&self, floor: f64, log2_floor: f64) -> f64 {
+        if self.err_acc > floor {
+            self.log_err_acc
+        } else {
+            log2_floor
+        }
+    }
+
     pub fn judge(&mut self, err: f64, h: f64) -> Verdict {
         if !err.is_finite() {
             self.rejected_last = true;
@@ -96,27 +112,22 @@ impl Controller {
         // powf: the next step waits for them, and their accuracy does not matter.
         let log_err = math::log2_coarse(err);
         if err <= 1.0 {
-            let log_previous = math::log2_coarse(self.previous_error);
+            let log_previous = self.floored(PI_FLOOR, LOG2_PI_FLOOR);
             // SAFETY / fac, fac = err^EXPONENT / previous^BETA / SAFETY clamped to [1/5, 10].
             let growth = (SAFETY * math::exp2_coarse(BETA * log_previous - EXPONENT * log_err))
                 .clamp(MIN_FACTOR, MAX_FACTOR);
             let mut h_next = h * growth;
             if self.h_acc > 0.0 {
-                let trend =
-                    math::exp2_coarse(PREDICTIVE_EXPONENT * (self.log_err_acc - 2.0 * log_err));
+                let log_err_acc = self.floored(PREDICTIVE_FLOOR, LOG2_PREDICTIVE_FLOOR);
+                let trend = math::exp2_coarse(PREDICTIVE_EXPONENT * (log_err_acc - 2.0 * log_err));
                 let predicted = h * (h / self.h_acc) * SAFETY * trend;
                 h_next = h_next.min(predicted.clamp(h * MIN_FACTOR, h * MAX_FACTOR));
             }
             self.h_acc = h;
-            self.log_err_acc = if err > PREDICTIVE_FLOOR {
-                log_err
-            } else {
-                math::log2_coarse(PREDICTIVE_FLOOR)
-            };
+            (self.err_acc, self.log_err_acc) = (err, log_err);
             if self.rejected_last {
                 h_next = h_next.min(h);
             }
-            self.previous_error = err.max(1e-4);
             self.rejected_last = false;
             Verdict {
                 accept: true,

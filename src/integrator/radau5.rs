@@ -208,7 +208,7 @@ impl<const N: usize> Factors<N> {
     /// The increment ΔW of one simplified Newton iteration in the transformed variables
     /// W = T⁻¹ Z (Hairer & Wanner, IV.8), from the stages' values F_s = f(t + c_s h, y0 + Z_s):
     /// ((γ/h) I − J) ΔW₁ = (T⁻¹F)₁ − (γ/h) W₁ and, for ΔW₂ + iΔW₃, the complex system with
-    /// (α + iβ)/h. `scaled` is (γ/h, α/h, β/h) for this h.
+    /// (α + iβ)/h, given (γ/h, α/h, β/h) for this h.
     #[inline]
     fn newton_increment(
         &self,
