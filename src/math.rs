@@ -461,4 +461,31 @@ mod tests {
         assert!((exp2_coarse(-5000.0) / 2f64.powi(-1022) - 1.0).abs() < 1.1e-4);
         assert!((exp2_coarse(5000.0) / 2f64.powi(1023) - 1.0).abs() < 1.1e-4);
     }
+
+    /// log2_coarse does not decrease as its argument grows, but for its rounding (a few ulps
+    /// of the result: the step-size controller's floors compare errors by their log2):
+    /// over 2^20 mantissas evenly spread on [1, 2), across a power of two, and ulp by ulp
+    /// about the controller's floors 1e-4 and 1e-2.
+    #[test]
+    fn log2_coarse_never_decreases() {
+        let rising = |xs: &mut dyn Iterator<Item = f64>| {
+            let mut last = (0.0, f64::NEG_INFINITY);
+            for x in xs {
+                let l = log2_coarse(x);
+                let rounding = 4.0 * f64::EPSILON * l.abs().max(1.0);
+                assert!(
+                    l >= last.1 - rounding,
+                    "log2_coarse({x:e}) = {l} < log2_coarse({:e}) = {}",
+                    last.0,
+                    last.1
+                );
+                last = (x, l);
+            }
+        };
+        rising(&mut (0..1u64 << 20).map(|k| 1.0 + k as f64 / (1u64 << 20) as f64));
+        for x0 in [2.0f64, 1e-4, 1e-2] {
+            let bits = x0.to_bits();
+            rising(&mut (bits - 100_000..bits + 100_000).map(f64::from_bits));
+        }
+    }
 }

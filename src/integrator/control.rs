@@ -61,7 +61,8 @@ pub struct Verdict {
 /// level. Through a smoothing band the contact stiffens with every step, so steps the PI
 /// controller grew were rejected: on S1 (1 s) the rejections fell from 411 to 185 at rtol
 /// 1.09e-5 with the cap, from 462 to 327 at 3.95e-6, and the error at rtol 1.1e-5 to 2e-5
-/// several-fold (`BENCH_DEBUG=gr` and `BENCH_PROFILE=1` of the work-precision bench). At
+/// several-fold (`BENCH_DEBUG=gr` and `BENCH_PROFILE=1` of the work-precision bench, on
+/// 9883bd6 before the cap and 9a5d602 with it). At
 /// equal error the CPU did not move beyond the noise: where the error stays within 1e-9 m at
 /// the tolerance and at the tighter ones `make bench` probes (rtol about 4.0e-6 before,
 /// 4.8e-6 after), 2.68 ms before and 2.76 ms after, 8 runs each in alternation.
@@ -69,9 +70,8 @@ pub struct Verdict {
 /// by how the previous band's last step went; forgetting it there gave no gain.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Controller {
-    /// The last accepted step's error and its log2, which both controllers read, each with
-    /// its own floor (the PI floor before the first step).
-    err_acc: f64,
+    /// log2 of the last accepted step's error, which both controllers read, each with its
+    /// own floor (the PI floor before the first step).
     log_err_acc: f64,
     rejected_last: bool,
     /// The last accepted step; 0 before the first.
@@ -81,7 +81,6 @@ pub struct Controller {
 impl Default for Controller {
     fn default() -> Self {
         Controller {
-            err_acc: PI_FLOOR,
             log_err_acc: LOG2_PI_FLOOR,
             rejected_last: false,
             h_acc: 0.0,
@@ -90,14 +89,12 @@ impl Default for Controller {
 }
 
 impl Controller {
-    /// log2 of the last accepted error floored at `floor` (whose log2 is `log2_floor`).
+    /// log2 of the last accepted error floored at the error whose log2 is `log2_floor`
+    /// (log2_coarse increases with its argument, but for its rounding: its cubic's slope
+    /// stays positive on [1, 2)).
     #[inline]
-    fn floored(&self, floor: f64, log2_floor: f64) -> f64 {
-        if self.err_acc > floor {
-            self.log_err_acc
-        } else {
-            log2_floor
-        }
+    fn floored(&self, log2_floor: f64) -> f64 {
+        self.log_err_acc.max(log2_floor)
     }
 
     pub fn judge(&mut self, err: f64, h: f64) -> Verdict {
@@ -112,19 +109,19 @@ impl Controller {
         // powf: the next step waits for them, and their accuracy does not matter.
         let log_err = math::log2_coarse(err);
         if err <= 1.0 {
-            let log_previous = self.floored(PI_FLOOR, LOG2_PI_FLOOR);
+            let log_previous = self.floored(LOG2_PI_FLOOR);
             // SAFETY / fac, fac = err^EXPONENT / previous^BETA / SAFETY clamped to [1/5, 10].
             let growth = (SAFETY * math::exp2_coarse(BETA * log_previous - EXPONENT * log_err))
                 .clamp(MIN_FACTOR, MAX_FACTOR);
             let mut h_next = h * growth;
             if self.h_acc > 0.0 {
-                let log_err_acc = self.floored(PREDICTIVE_FLOOR, LOG2_PREDICTIVE_FLOOR);
+                let log_err_acc = self.floored(LOG2_PREDICTIVE_FLOOR);
                 let trend = math::exp2_coarse(PREDICTIVE_EXPONENT * (log_err_acc - 2.0 * log_err));
                 let predicted = h * (h / self.h_acc) * SAFETY * trend;
                 h_next = h_next.min(predicted.clamp(h * MIN_FACTOR, h * MAX_FACTOR));
             }
             self.h_acc = h;
-            (self.err_acc, self.log_err_acc) = (err, log_err);
+            self.log_err_acc = log_err;
             if self.rejected_last {
                 h_next = h_next.min(h);
             }
