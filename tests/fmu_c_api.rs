@@ -6,7 +6,8 @@ use fmi::fmi2::import::Fmi2Import;
 use fmi::fmi2::instance::{CoSimulation, Common};
 use gear_rattle::contract::vr;
 use gear_rattle::packaging::{Binary, write_fmu};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
 
 /// target/<profile>, from this test executable's path (target/<profile>/deps/…).
 fn profile_dir() -> PathBuf {
@@ -24,19 +25,29 @@ fn cdylib() -> PathBuf {
     lib
 }
 
+/// The FMU packaged once per test process: the tests of this file run in parallel threads,
+/// and each rewriting one shared zip while another reads it gave "incomplete deflate stream".
+fn fmu() -> &'static Path {
+    static FMU: OnceLock<PathBuf> = OnceLock::new();
+    FMU.get_or_init(|| {
+        let dir = std::env::temp_dir().join(format!("gear_rattle_test_{}", std::process::id()));
+        let fmu = dir.join("GearRattle.fmu");
+        write_fmu(
+            &fmu,
+            &[Binary {
+                platform: "linux64",
+                extension: "so",
+                path: &cdylib(),
+            }],
+        )
+        .unwrap();
+        fmu
+    })
+}
+
+/// Each call extracts the FMU into a directory of its own (the `fmi` crate's temp dir).
 fn import() -> Fmi2Import {
-    let dir = std::env::temp_dir().join(format!("gear_rattle_test_{}", std::process::id()));
-    let fmu = dir.join("GearRattle.fmu");
-    write_fmu(
-        &fmu,
-        &[Binary {
-            platform: "linux64",
-            extension: "so",
-            path: &cdylib(),
-        }],
-    )
-    .unwrap();
-    fmi::import::from_path(&fmu).unwrap()
+    fmi::import::from_path(fmu()).unwrap()
 }
 
 #[test]
