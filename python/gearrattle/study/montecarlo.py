@@ -1,0 +1,193 @@
+"""The Monte Carlo study's answers, per operating point: the distribution of each metric
+(percentiles; histogram and ECDF figures), the probability of exceeding each user threshold
+with its 95 % Clopper-Pearson interval, and Sobol' (Saltelli) or Morris sensitivity indices
+(SALib). Written to percentiles.csv, exceedance.csv, sensitivity.csv and mc_*.png."""
+
+import csv
+import os
+
+import numpy as np
+
+from . import designs
+from .report import column, ok_rows
+
+PERCENTILES = (1, 5, 25, 50, 75, 95, 99)
+CONFIDENCE = 0.95
+
+
+def _operating_points(st, table):
+    """[(label, row mask)]: one per --at operating point (all rows when there is none)."""
+    if not st.at:
+        return [("", np.ones(table.num_rows, bool))]
+    out = []
+    for point, _ in st.at:
+        mask = np.ones(table.num_rows, bool)
+        for name, value in point.items():
+            mask &= column(table, name) == value
+        out.append((", ".join(f"{k} = {v:g}" for k, v in point.items()), mask))
+    return out
+
+
+def exceedance(k, n, confidence=CONFIDENCE):
+    """(k/n, low, high): the share and its Clopper-Pearson (exact binomial) interval."""
+    from scipy.stats import binomtest
+
+    if n == 0:
+        return float("nan"), float("nan"), float("nan")
+    ci = binomtest(k, n).proportion_ci(confidence_level=confidence, method="exact")
+    return k / n, ci.low, ci.high
+
+
+def analyse(st, table, metrics):
+    ok = ok_rows(table)
+    lines, files, pct_rows, exc_rows, sens_rows = [], [], [], [], []
+    for label, mask in _operating_points(st, table):
+        sel = mask & ok
+        head = f"at {label}" if label else "over the sample"
+        lines.append(f"Monte Carlo {head}: {int(sel.sum())} of {int(mask.sum())} points ok")
+        for m in metrics:
+            x = column(table, m)[sel]
+            if len(x):
+                q = np.percentile(x, PERCENTILES)
+                pct_rows.append([label, m, len(x), np.mean(x), np.std(x, ddof=1) if len(x) > 1
+                                 else float("nan"), *q])
+        for e in st.exceed:
+            x = column(table, e.metric)[sel]
+            k = int(np.count_nonzero(e.test(x)))
+            p, lo, hi = exceedance(k, len(x))
+            exc_rows.append([label, str(e), k, len(x), p, lo, hi])
+            lines.append(f"  P({e}) = {k}/{len(x)} = {100 * p:.1f} % ({100 * CONFIDENCE:g} % "
+                         f"Clopper-Pearson interval {100 * lo:.1f}..{100 * hi:.1f} %)")
+        if st.sensitivity != "none":
+            more, rows = _sensitivity(st, table, mask, metrics, label)
+            lines += more
+            sens_rows += rows
+        files.append(_figure(st, table, sel, metrics, label, len(files)))
+    files.append(_csv(st.out, "percentiles.csv", ["operating_point", "metric", "n", "mean", "sd"]
+                      + [f"p{p}" for p in PERCENTILES], pct_rows))
+    if exc_rows:
+        files.append(_csv(st.out, "exceedance.csv", ["operating_point", "event", "k", "n", "p",
+                                                     "ci_low", "ci_high"], exc_rows))
+    if sens_rows:
+        cols = (["operating_point", "metric", "parameter", "S1", "S1_conf", "ST", "ST_conf"]
+                if st.sensitivity == "sobol" else
+                ["operating_point", "metric", "parameter", "mu_star", "mu_star_conf", "sigma"])
+        files.append(_csv(st.out, "sensitivity.csv", cols, sens_rows))
+        files.append(_sensitivity_figure(st, sens_rows))
+    return lines, files
+
+
+def _sensitivity(st, table, mask, metrics, label):
+    """Indices of each metric over the design's rows at one operating point. Needs every row:
+    a refused point leaves the design incomplete, and the indices are not computed."""
+    lines, rows = [], []
+    ok = ok_rows(table)[mask]
+    if not ok.all():
+        return [f"  sensitivity not computed: {int((~ok).sum())} points refused (see "
+                f"points.csv)"], []
+    prob = designs.problem(st)
+    names = prob["names"]
+    for m in metrics:
+        y = column(table, m)[mask]
+        if np.ptp(y) == 0:
+            continue  # a constant metric has no sensitivity to apportion
+        if st.sensitivity == "sobol":
+            from SALib.analyze import sobol
+
+            r = sobol.analyze(prob, y, calc_second_order=False, seed=st.seed)
+            rows += [[label, m, p, r["S1"][i], r["S1_conf"][i], r["ST"][i], r["ST_conf"][i]]
+                     for i, p in enumerate(names)]
+        else:
+            from SALib.analyze import morris
+
+            x = designs.unit_sample(st)
+            r = morris.analyze(prob, x, y, num_levels=designs.MORRIS_LEVELS, seed=st.seed)
+            rows += [[label, m, p, r["mu_star"][i], r["mu_star_conf"][i], r["sigma"][i]]
+                     for i, p in enumerate(names)]
+    lines.append(f"  {st.sensitivity} indices of {len({r[1] for r in rows})} metrics: "
+                 f"sensitivity.csv, mc_sensitivity.png")
+    return lines, rows
+
+
+def _csv(out, name, header, rows):
+    path = os.path.join(out, name)
+    with open(path, "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(header)
+        w.writerows([f"{v:.6g}" if isinstance(v, float) else v for v in r] for r in rows)
+    return path
+
+
+def _plt():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def _figure(st, table, sel, metrics, label, k):
+    """Histogram and ECDF of each metric: mc_distributions[_k].png."""
+    plt = _plt()
+    cols = 4
+    rows = -(-len(metrics) // cols)
+    fig, axes = plt.subplots(rows, cols, figsize=(4 * cols, 2.8 * rows), squeeze=False,
+                             constrained_layout=True)
+    for ax, m in zip(axes.flat, metrics):
+        x = np.sort(column(table, m)[sel])
+        ax.hist(x, bins=min(40, max(5, len(x) // 20)), color="tab:blue", alpha=0.6)
+        ax.set_xlabel(m, fontsize=8)
+        ax.tick_params(labelsize=7)
+        e = ax.twinx()
+        e.plot(x, np.arange(1, len(x) + 1) / len(x), color="k", lw=1)
+        e.set_ylim(0, 1)
+        e.tick_params(labelsize=7)
+        for ex in st.exceed:
+            if ex.metric == m:
+                ax.axvline(ex.value, color="tab:red", ls="--", lw=1)
+    for ax in list(axes.flat)[len(metrics):]:
+        ax.axis("off")
+    dists = "; ".join(str(d) for d in st.dists)
+    fig.suptitle(f"Monte Carlo{' at ' + label if label else ''}: {int(sel.sum())} gearboxes "
+                 f"({dists}); bars histogram, line ECDF, dashed thresholds", fontsize=9)
+    path = os.path.join(st.out, f"mc_distributions{'_' + str(k) if k else ''}.png")
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+    return path
+
+
+def _sensitivity_figure(st, rows):
+    """Bars of the indices (S1 and ST, or mu*) per parameter for each metric and operating
+    point: mc_sensitivity.png."""
+    plt = _plt()
+    keys = sorted({(r[0], r[1]) for r in rows})
+    names = [d.name for d in st.dists]
+    cols = 4
+    nrow = -(-len(keys) // cols)
+    fig, axes = plt.subplots(nrow, cols, figsize=(4 * cols, 2.6 * nrow), squeeze=False,
+                             constrained_layout=True)
+    x = np.arange(len(names))
+    for ax, key in zip(axes.flat, keys):
+        sel = {r[2]: r for r in rows if (r[0], r[1]) == key}
+        if st.sensitivity == "sobol":
+            ax.bar(x - 0.2, [sel[n][3] for n in names], 0.4, yerr=[sel[n][4] for n in names],
+                   label="S1")
+            ax.bar(x + 0.2, [sel[n][5] for n in names], 0.4, yerr=[sel[n][6] for n in names],
+                   label="ST")
+        else:
+            ax.bar(x, [sel[n][3] for n in names], 0.6, yerr=[sel[n][4] for n in names],
+                   label="mu*")
+        ax.set_xticks(x)
+        ax.set_xticklabels(names, fontsize=7)
+        ax.set_title(f"{key[1]}" + (f" at {key[0]}" if key[0] else ""), fontsize=8)
+        ax.tick_params(labelsize=7)
+    axes.flat[0].legend(fontsize=7)
+    for ax in list(axes.flat)[len(keys):]:
+        ax.axis("off")
+    fig.suptitle(f"{'Sobol' if st.sensitivity == 'sobol' else 'Morris'} indices "
+                 f"({st.n} base samples)", fontsize=9)
+    path = os.path.join(st.out, "mc_sensitivity.png")
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+    return path

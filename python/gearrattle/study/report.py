@@ -1,0 +1,59 @@
+"""What a study writes besides its points: summary.txt (also printed) and the figures of its
+kind: heat maps for a map, parameter-metric scatter plots for a DOE, and for a Monte Carlo the
+distributions, exceedance probabilities and sensitivity indices (gearrattle.study.montecarlo)."""
+
+import os
+
+import numpy as np
+
+
+def ok_rows(table):
+    return np.asarray(table.column("status").to_pylist()) == "ok"
+
+
+def column(table, name):
+    return np.asarray(table.column(name).to_numpy(zero_copy_only=False), dtype=float)
+
+
+def write(st, model, table, wall):
+    """Summary lines and the list of files written."""
+    from . import figures, montecarlo
+
+    n = table.num_rows
+    ok = ok_rows(table)
+    cpu = column(table, "cpu_s")
+    files = [os.path.join(st.out, "points.parquet"), os.path.join(st.out, "points.csv")]
+    lines = [f"{st.kind} study of {st.fmu} (GUID {model.guid}): {n} points, {int(ok.sum())} ok, "
+             f"{n - int(ok.sum())} refused; {st.duration:g} s each"
+             + (f", statistics from {st.stats_from[0]:g} s" if st.stats_from else "")]
+    lines.append(f"  fixed: " + (", ".join(f"{k} = {v:g}" for k, (v, _) in st.fixed.items())
+                                 or "-"))
+    if np.isfinite(cpu).any():
+        lines.append(f"  CPU per point: median {1e3 * np.nanmedian(cpu):.2f} ms, total "
+                     f"{np.nansum(cpu):.1f} s; wall {wall:.1f} s for the points run now")
+    for status, msg in sorted({(s, m) for s, m in zip(table.column("status").to_pylist(),
+                                                        table.column("message").to_pylist())
+                               if s != "ok"})[:10]:
+        lines.append(f"  {status}: {msg}")
+    metrics = [v.name for v in model.metrics] + list(st.record)
+    if not metrics:
+        lines.append("  this FMU has no stat_* outputs: the rows hold the parameters and status")
+    elif ok.any():
+        lines.append(f"  {'metric':24s} {'min':>11s} {'median':>11s} {'max':>11s}")
+        for m in metrics:
+            x = column(table, m)[ok]
+            lines.append(f"  {m:24s} {np.nanmin(x):11.4g} {np.nanmedian(x):11.4g} "
+                         f"{np.nanmax(x):11.4g}")
+    if st.kind == "map" and metrics:
+        files += figures.map_figures(st, table, metrics)
+    elif st.kind == "doe" and metrics:
+        files += figures.doe_figures(st, table, metrics)
+    elif st.kind == "mc" and metrics:
+        more, extra = montecarlo.analyse(st, table, metrics)
+        lines += more
+        files += extra
+    path = os.path.join(st.out, "summary.txt")
+    with open(path, "w") as fh:
+        fh.write("\n".join(lines) + "\n")
+    files.append(path)
+    return lines, files

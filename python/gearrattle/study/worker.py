@@ -1,0 +1,226 @@
+"""The study's work on one process: the FMU extracted once per GUID, one FMU instance per thread
+reused with fmi2Reset between points, and a batch of points run on it.
+
+A point is set up the way a user sets up a fresh instance (fmi2SetupExperiment, the start values,
+initialization), stepped to its duration in one fmi2DoStep, and its `stat_*` outputs read. A
+point the FMU refuses is returned with status "refused" and the FMU's own error message; it is
+not retried. Nothing here that holds a pointer leaves the process: batches come in as plain
+values and go out as plain dicts."""
+
+import ctypes
+import io
+import itertools
+import os
+import shutil
+import tempfile
+import threading
+import time
+import zipfile
+
+from distributed.diagnostics.plugin import WorkerPlugin
+
+from .model import read_model
+
+_FMUS = {}  # GUID -> (extracted directory, Model), per process
+_LOCK = threading.Lock()
+_THREAD = threading.local()  # .instances: GUID -> Instance, one per thread
+_LOGS = {}  # instance name -> list of (status, message), filled by the logger callback
+_NAMES = itertools.count()
+
+
+def install_fmu(guid, data):
+    """Extract the FMU (its bytes) once per process; later calls with the same GUID are free."""
+    with _LOCK:
+        if guid not in _FMUS:
+            path = tempfile.mkdtemp(prefix="gearrattle-fmu-")
+            zipfile.ZipFile(io.BytesIO(data)).extractall(path)
+            model = read_model(path)
+            if model.guid != guid:
+                raise ValueError(f"FMU bytes have GUID {model.guid}, expected {guid}")
+            _FMUS[guid] = (path, model)
+        return _FMUS[guid]
+
+
+def uninstall_fmu(guid):
+    """Remove the extracted FMU (a worker plugin's teardown)."""
+    with _LOCK:
+        entry = _FMUS.pop(guid, None)
+    if entry:
+        shutil.rmtree(entry[0], ignore_errors=True)
+
+
+def _log(_env, instance, status, _category, message):
+    logs = _LOGS.get((instance or b"").decode("utf-8", "replace"))
+    if logs is not None:
+        logs.append((int(status), (message or b"").decode("utf-8", "replace")))
+
+
+def _make_logger():
+    from fmpy.fmi2 import fmi2CallbackLoggerTYPE
+
+    return fmi2CallbackLoggerTYPE(_log)
+
+
+_LOGGER = None  # made on first use: fmpy is imported lazily, workers import this module early
+
+
+def _route_messages():
+    """fmpy's native proxy (it formats the variadic messages) sends every FMU's messages to the
+    last Python logger it was given, process-wide: point it at ours before each point, so that
+    other fmpy users in the same process (a test session) cannot take the messages away."""
+    from fmpy.fmi2 import fmi2CallbackFunctions
+    from fmpy.logging import addLoggerProxy
+
+    global _LOGGER
+    if _LOGGER is None:
+        _LOGGER = _make_logger()
+    cb = fmi2CallbackFunctions()
+    cb.logger = _LOGGER
+    addLoggerProxy(ctypes.byref(cb))
+    return cb
+
+
+class Instance:
+    """One FMU instance, reused for point after point."""
+
+    def __init__(self, unzipdir, model):
+        from fmpy import calloc, free
+        from fmpy.fmi2 import (FMU2Slave, fmi2CallbackAllocateMemoryTYPE,
+                               fmi2CallbackFreeMemoryTYPE)
+
+        self.model = model
+        self.name = f"study{os.getpid()}_{next(_NAMES)}"
+        self.logs = _LOGS.setdefault(self.name, [])
+        self.callbacks = _route_messages()  # its logger becomes the formatting proxy
+        self.callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
+        self.callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
+        self.fmu = FMU2Slave(guid=model.guid, unzipDirectory=unzipdir,
+                             modelIdentifier=model.model_identifier, instanceName=self.name)
+        self.fmu.instantiate(callbacks=self.callbacks, loggingOn=False)
+        self.fresh = True
+        self.metric_real = [v for v in model.metrics if v.type == "Real"]
+        self.metric_int = [v for v in model.metrics if v.type != "Real"]
+
+    def close(self):
+        self.fmu.freeInstance()
+        _LOGS.pop(self.name, None)
+
+    def run(self, values, duration, record=()):
+        """Run one point: values = {parameter name: value}. Returns a dict of the metrics (and
+        the recorded outputs), status, message and cpu_s."""
+        from fmpy.fmi1 import FMICallException
+
+        t0 = time.process_time()
+        _route_messages()
+        self.logs.clear()
+        row, call = {}, "fmi2Reset"
+        try:
+            if not self.fresh:
+                self.fmu.reset()
+            self.fresh = False
+            call = "fmi2SetupExperiment"
+            self.fmu.setupExperiment(startTime=0.0, stopTime=duration)
+            call = "fmi2Set*"
+            self._set(values)
+            call = "fmi2EnterInitializationMode"
+            self.fmu.enterInitializationMode()
+            call = "fmi2ExitInitializationMode"
+            self.fmu.exitInitializationMode()
+            call = "fmi2DoStep"
+            self.fmu.doStep(0.0, duration)
+            call = "fmi2Get*"
+            row.update(self._get(self.metric_real, self.metric_int))
+            if record:
+                rec = [self.model.outputs[n] for n in record]
+                row.update(self._get([v for v in rec if v.type == "Real"],
+                                     [v for v in rec if v.type != "Real"]))
+            row.update(status="ok", message="")
+        except FMICallException as e:
+            msgs = [m for s, m in self.logs if s >= 2] or [m for _, m in self.logs]
+            label = ("ok", "warning", "discard", "error", "fatal")[min(e.status, 4)]
+            row.update(status="refused", message=f"{call} returned {label}"
+                       + (f": {msgs[-1]}" if msgs else " (the FMU logged no message)"))
+            if e.status >= 4:  # fmi2Fatal: the instance is gone; the next point gets a new one
+                raise _Fatal(row) from e
+        row["cpu_s"] = time.process_time() - t0
+        return row
+
+    def _set(self, values):
+        real, ints, bools = [], [], []
+        for name, value in values.items():
+            v = self.model.parameters[name]
+            (real if v.type == "Real" else bools if v.type == "Boolean" else ints).append(
+                (v.vr, value))
+        if real:
+            self.fmu.setReal([vr for vr, _ in real], [float(x) for _, x in real])
+        if ints:
+            self.fmu.setInteger([vr for vr, _ in ints], [int(x) for _, x in ints])
+        if bools:
+            self.fmu.setBoolean([vr for vr, _ in bools], [bool(x) for _, x in bools])
+
+    def _get(self, real, ints):
+        out = {}
+        if real:
+            out.update(zip((v.name for v in real), self.fmu.getReal([v.vr for v in real])))
+        if ints:
+            out.update(zip((v.name for v in ints), self.fmu.getInteger([v.vr for v in ints])))
+        return out
+
+
+class _Fatal(Exception):
+    """fmi2Fatal from the FMU: carries the point's row; the instance must be dropped."""
+
+    def __init__(self, row):
+        super().__init__(row["message"])
+        self.row = row
+
+
+def instance(guid):
+    """This thread's instance of the FMU with this GUID (created on first use)."""
+    insts = getattr(_THREAD, "instances", None)
+    if insts is None:
+        insts = _THREAD.instances = {}
+    if guid not in insts:
+        if guid not in _FMUS:
+            raise RuntimeError(f"FMU {guid} is not installed in this process (install_fmu)")
+        insts[guid] = Instance(*_FMUS[guid])
+    return insts[guid]
+
+
+def drop_instance(guid):
+    insts = getattr(_THREAD, "instances", {})
+    inst = insts.pop(guid, None)
+    if inst is not None:
+        _LOGS.pop(inst.name, None)
+
+
+def run_batch(guid, duration, record, points):
+    """Run a batch of points [(point index, point id, {name: value})] on this thread's instance.
+    Returns one row (a dict) per point, in order."""
+    rows = []
+    for index, pid, values in points:
+        try:
+            row = instance(guid).run(values, duration, record)
+        except _Fatal as e:
+            drop_instance(guid)
+            row = e.row
+            row["cpu_s"] = float("nan")
+        row.update(point=index, point_id=pid)
+        rows.append(row)
+    return rows
+
+
+
+class FMUPlugin(WorkerPlugin):
+    """Installs the FMU on every worker, including workers that join or restart later: the FMU
+    travels with the plugin, no shared file system is needed."""
+
+    def __init__(self, guid, data):
+        self.guid, self.data = guid, data
+        self.name = f"gearrattle-fmu-{guid}"
+
+    def setup(self, worker):
+        install_fmu(self.guid, self.data)
+
+    def teardown(self, worker):
+        uninstall_fmu(self.guid)

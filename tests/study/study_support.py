@@ -1,0 +1,97 @@
+"""Helpers and fixtures of the study runner's tests (imported by the test modules: a conftest.py
+here would shadow tests/python's, which its tests import by name): the FMU (a missing build
+FAILS, never skips), the `gearrattle-study` command run as a user runs it, its results read
+back, and a real Dask cluster on localhost (`dask scheduler` and two `dask worker` processes,
+started once for the session)."""
+
+import os
+import pathlib
+import socket
+import subprocess
+import sys
+
+import pyarrow.parquet as pq
+import pytest
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+FMU = ROOT / "target" / "fmu" / "GearRattle.fmu"
+BIN = pathlib.Path(sys.executable).parent
+STUDY = BIN / "gearrattle-study"
+
+
+def study(*args, check=True, **kw):
+    """Run gearrattle-study with these arguments; the finished process."""
+    p = subprocess.run([str(STUDY), *map(str, args), "--quiet"], capture_output=True,
+                       text=True, timeout=300, **kw)
+    if check and p.returncode != 0:
+        raise AssertionError(f"gearrattle-study {' '.join(map(str, args))} failed "
+                             f"({p.returncode}):\n{p.stderr[-3000:]}")
+    return p
+
+
+def rows(out):
+    """The study's points without cpu_s (the one column allowed to differ between runs)."""
+    return pq.read_table(os.path.join(out, "points.parquet")).drop(["cpu_s"])
+
+
+def free_port():
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+class LocalhostCluster:
+    """`dask scheduler` and two `dask worker` processes on 127.0.0.1, each worker in its own
+    empty directory (the FMU reaches them through the runner, not through a shared file)."""
+
+    def __init__(self, tmp):
+        self.port = free_port()
+        self.address = f"tcp://127.0.0.1:{self.port}"
+        dask = str(BIN / "dask")
+        self.procs = [subprocess.Popen(
+            [dask, "scheduler", "--host", "127.0.0.1", "--port", str(self.port),
+             "--no-dashboard"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)]
+        for k in range(2):
+            cwd = tmp / f"worker{k}"
+            cwd.mkdir()
+            self.procs.append(subprocess.Popen(
+                [dask, "worker", self.address, "--nworkers", "1", "--nthreads", "1",
+                 "--host", "127.0.0.1", "--no-dashboard", "--local-directory", str(cwd)],
+                cwd=cwd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
+        self.wait_for_workers(2)
+
+    def client(self):
+        from distributed import Client
+
+        return Client(self.address, timeout="30s")
+
+    def wait_for_workers(self, n, timeout=60):
+        with self.client() as c:
+            c.wait_for_workers(n, timeout=timeout)
+
+    def worker_pids(self):
+        with self.client() as c:
+            return list(c.run(os.getpid).values())
+
+    def close(self):
+        for p in reversed(self.procs):
+            p.terminate()
+        for p in self.procs:
+            try:
+                p.wait(timeout=20)
+            except subprocess.TimeoutExpired:
+                p.kill()
+
+
+@pytest.fixture(scope="session")
+def fmu():
+    if not FMU.is_file():
+        pytest.fail(f"{FMU} is missing: build it with `make fmu`")
+    return str(FMU)
+
+
+@pytest.fixture(scope="session")
+def cluster(tmp_path_factory):
+    c = LocalhostCluster(tmp_path_factory.mktemp("cluster"))
+    yield c
+    c.close()

@@ -1,0 +1,80 @@
+"""The same study gives the same rows, bit for bit (every column but cpu_s), serially in this
+process, on a LocalCluster and on a real multi-process cluster on localhost; a worker killed in
+the middle of a study costs no point; an interrupted study resumes where it stopped."""
+
+import os
+import signal
+import subprocess
+import time
+
+from study_support import STUDY, cluster, fmu, rows, study  # noqa: F401 (fixtures)
+
+# A small map in sine mode: 4 x 3 points of 0.3 s, statistics from 0.1 s where the FMU has them.
+SMALL = ["map", "--x", "f_exc=30:60:4", "--y", "A_rms=100:500:3", "--duration", "0.3",
+         "--record", "impacts_Fplus", "--record", "impacts_Fminus", "--record", "xi",
+         "--record", "E_contact"]
+# Long enough to be interrupted: 240 points of 4 s (about 10 ms of CPU each).
+LONG = ["doe", "--param", "f_exc=30:60", "--param", "A_rms=100:700", "--design", "lhs",
+        "--n", "240", "--duration", "4", "--record", "impacts_Fplus", "--record", "xi"]
+
+
+def test_serial_local_cluster_and_localhost_cluster_agree(fmu, cluster, tmp_path):
+    outs = {k: str(tmp_path / k) for k in ("serial", "local", "cluster")}
+    study(*SMALL, "--fmu", fmu, "--out", outs["serial"], "--workers", "0")
+    study(*SMALL, "--fmu", fmu, "--out", outs["local"], "--workers", "2")
+    study(*SMALL, "--fmu", fmu, "--out", outs["cluster"], "--scheduler", cluster.address)
+    ref = rows(outs["serial"])
+    assert ref.num_rows == 12
+    assert set(ref.column("status").to_pylist()) == {"ok"}
+    assert rows(outs["local"]).equals(ref)
+    assert rows(outs["cluster"]).equals(ref)
+
+
+def _partials(out):
+    d = os.path.join(out, "partial")
+    return [f for f in os.listdir(d) if f.endswith(".parquet")] if os.path.isdir(d) else []
+
+
+def _start_and_wait(args, out, n_files):
+    """Start the study in the background; return it once n_files batches are stored."""
+    p = subprocess.Popen([str(STUDY), *args, "--quiet"], stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 120
+    while len(_partials(out)) < n_files:
+        assert p.poll() is None, f"the study ended before it could be interrupted:\n{p.stderr.read()}"
+        assert time.monotonic() < deadline, "no batch stored in 120 s"
+        time.sleep(0.02)
+    return p
+
+
+def test_worker_killed_mid_study_loses_no_point(fmu, cluster, tmp_path):
+    ref, out = str(tmp_path / "undisturbed"), str(tmp_path / "killed")
+    study(*LONG, "--fmu", fmu, "--out", ref, "--workers", "0")
+    p = _start_and_wait([*LONG, "--fmu", fmu, "--out", out, "--scheduler", cluster.address],
+                        out, 2)
+    victim = cluster.worker_pids()[0]
+    os.kill(victim, signal.SIGKILL)
+    _, err = p.communicate(timeout=300)
+    assert p.returncode == 0, err[-3000:]
+    assert len(_partials(out)) < 240  # the kill came mid-study, not after it
+    got = rows(out)
+    assert got.num_rows == 240
+    assert got.equals(rows(ref))
+    cluster.wait_for_workers(2)  # the nanny restarted the killed worker
+    assert victim not in cluster.worker_pids()
+
+
+def test_interrupted_study_resumes_without_recomputing(fmu, tmp_path):
+    ref, out = str(tmp_path / "whole"), str(tmp_path / "interrupted")
+    study(*LONG, "--fmu", fmu, "--out", ref, "--workers", "0")
+    p = _start_and_wait([*LONG, "--fmu", fmu, "--out", out, "--workers", "0"], out, 1)
+    p.send_signal(signal.SIGKILL)
+    p.wait(timeout=30)
+    kept = len(_partials(out))
+    assert not os.path.exists(os.path.join(out, "points.parquet"))
+    again = subprocess.run([str(STUDY), *LONG, "--fmu", fmu, "--out", out, "--workers", "0"],
+                           capture_output=True, text=True, timeout=300)
+    assert again.returncode == 0, again.stderr[-3000:]
+    assert "points already in" in again.stdout
+    assert rows(out).equals(rows(ref))
+    assert len(_partials(out)) > kept

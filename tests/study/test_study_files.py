@@ -1,0 +1,83 @@
+"""A bad study is refused before anything runs: exit code 2, a message naming the line (or the
+flag) and the fix, and no results directory."""
+
+import os
+import textwrap
+
+import pytest
+
+from gearrattle.study import cli
+from study_support import fmu  # noqa: F401 (fixture)
+
+GOOD = """\
+kind = "mc"
+out = "{out}"
+fmu = "{fmu}"
+n = 8
+seed = 1
+duration = 0.2
+
+[set]
+f_exc = 30.0
+A_rms = 300.0
+
+[dist]
+G = "truncnormal:25e-6:1.7e-6:20e-6:30e-6"
+C = "normal:0.025:0.0017"
+"""
+
+# (what is wrong, a replacement in GOOD, the line named, words of the message)
+CASES = [
+    ("unknown parameter", ('C = "normal', 'Cx = "normal'), 14, ["'Cx'", "not a parameter",
+                                                               "did you mean C"]),
+    ("value above the FMU's maximum", ("A_rms = 300.0", "A_rms = 300.0\nexcitation = 3"), 11,
+     ["excitation = 3", "above the FMU's maximum 2", "keep excitation within"]),
+    ("malformed TOML", ("n = 8", "n = 8 8"), 4, ["malformed TOML", "Fix the syntax"]),
+    ("negative width", ("0.025:0.0017", "0.025:-0.0017"), 14, ["width must be positive",
+                                                              "SD > 0"]),
+    ("empty truncation interval", ("20e-6:30e-6", "30e-6:20e-6"), 13, ["empty interval",
+                                                                      "LO < HI"]),
+    ("unknown key", ("seed = 1", "sead = 1"), 5, ["unknown key 'sead'", "did you mean 'seed'"]),
+]
+
+
+@pytest.mark.parametrize("what, change, line, words", CASES, ids=[c[0] for c in CASES])
+def test_bad_study_file_is_refused_before_running(what, change, line, words, fmu, tmp_path,
+                                                   capsys):
+    out = tmp_path / "results"
+    text = GOOD.format(out=out, fmu=fmu)
+    assert change[0] in text
+    path = tmp_path / "study.toml"
+    path.write_text(text.replace(change[0], change[1]))
+    assert cli.main(["run", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert f"line {line}" in err, err
+    for w in words:
+        assert w in err, err
+    assert not os.path.exists(out)
+
+
+def test_good_study_file_runs(fmu, tmp_path):
+    out = tmp_path / "results"
+    path = tmp_path / "study.toml"
+    path.write_text(GOOD.format(out=out, fmu=fmu))
+    assert cli.main(["run", str(path), "--workers", "0", "--quiet"]) == 0
+    assert os.path.isfile(out / "points.parquet")
+
+
+@pytest.mark.parametrize("args, words", [
+    (["map", "--x", "f_exc=60:30:4"], ["--x f_exc=60:30:4", "empty range", "LO < HI"]),
+    (["doe", "--param", "G=3e-5:1e-5", "--n", "4"], ["--param G=3e-5:1e-5", "empty range"]),
+    (["mc", "--dist", "G=uniform:3e-5:1e-5", "--n", "4"], ["negative or zero width",
+                                                           "LO < HI"]),
+    (["mc", "--dist", "g=normal:2e-5:1e-6", "--n", "4"], ["'g'", "did you mean G"]),
+    (["map", "--set", "solver=7"], ["solver = 7", "maximum 2"]),
+], ids=["map empty range", "doe empty range", "mc negative width", "unknown name",
+        "above maximum"])
+def test_bad_flags_are_refused_before_running(args, words, fmu, tmp_path, capsys):
+    out = tmp_path / "results"
+    assert cli.main([*args, "--fmu", fmu, "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    for w in words:
+        assert w in err, err
+    assert not os.path.exists(out)
