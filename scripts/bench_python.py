@@ -33,15 +33,14 @@ import csv
 import math
 import pathlib
 import statistics
-import sys
 import time
 
 import numpy as np
 from scipy.integrate import solve_ivp
 
+from gearrattle import reference as R
+
 ROOT = pathlib.Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "tests" / "python"))
-import reference as R  # noqa: E402
 
 TOLS = [1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10]
 COMM_STEPS = [1e-2, 1e-3, 1e-4, 1e-5]

@@ -24,14 +24,13 @@ from __future__ import annotations
 import argparse
 import csv
 import pathlib
-import sys
 import time
 
 import numpy as np
 
+from gearrattle import reference as R
+
 ROOT = pathlib.Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "tests" / "python"))
-import reference as R  # noqa: E402
 
 GRID = 1e-3  # the error grid of every solver [s]
 PERTURBATION = 1e-4  # of G, for the predictable window

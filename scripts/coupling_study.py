@@ -30,12 +30,11 @@ import time
 
 import numpy as np
 
-ROOT = pathlib.Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "tests" / "masters"))
+from gearrattle import masters as MS
+from gearrattle import monolithic as M
+from gearrattle import reference as R
 
-import masters as MS  # noqa: E402
-import monolithic as M  # noqa: E402
-import reference as R  # noqa: E402
+ROOT = pathlib.Path(__file__).resolve().parents[1]
 
 WINDOW = 0.1  # s: pointwise errors are compared over [0, WINDOW] (see the report)
 DEFAULT_STEPS = (1e-3, 5e-4, 2e-4, 1e-4, 5e-5, 2e-5, 1e-5)

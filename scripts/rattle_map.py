@@ -52,11 +52,10 @@ from matplotlib.colors import BoundaryNorm, LogNorm  # noqa: E402
 from matplotlib.patches import Rectangle  # noqa: E402
 from matplotlib.ticker import FuncFormatter  # noqa: E402
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-ROOT = os.path.dirname(HERE)
-sys.path.insert(0, HERE)
-import rattle_stats as rs  # noqa: E402
 from demo import SCENES, dist_str, read_params  # noqa: E402  (reuse, no duplicate)
+from gearrattle import rattle_stats as rs  # noqa: E402
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 GRID_OUTPUTS = ["impacts_Fplus", "impacts_Fminus", "impact_speed", "E_contact", "E_lubricant",
                 "a_pitch_L", "omega_L", "contact"]

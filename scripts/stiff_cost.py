@@ -7,14 +7,13 @@ the FMU counts them, and the CPU time of the run (process time, fmpy included).
 
 import argparse
 import pathlib
-import sys
 import time
 
 from fmpy import simulate_fmu
 
+from gearrattle import reference as R
+
 ROOT = pathlib.Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "tests" / "python"))
-import reference as R  # noqa: E402
 
 SOLVERS = {0: "auto", 1: "DOPRI5", 2: "Radau IIA"}
 

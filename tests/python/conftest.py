@@ -4,21 +4,18 @@ The FMU tests need target/fmu/GearRattle.fmu: when it is missing they FAIL (neve
 with a message telling how to build it, so that a missing build cannot pass silently."""
 
 import pathlib
-import sys
 import tomllib
 
 import numpy as np
 import pytest
+
+from gearrattle import reference as R
 
 HERE = pathlib.Path(__file__).resolve().parent
 ROOT = HERE.parents[1]
 FMU_PATH = ROOT / "target" / "fmu" / "GearRattle.fmu"
 CONTRACT_PATH = ROOT / "modelDescription" / "GearRattle.toml"
 
-if str(HERE) not in sys.path:
-    sys.path.insert(0, str(HERE))
-
-import reference as R  # noqa: E402
 
 
 def contract_outputs() -> list:

@@ -45,19 +45,16 @@ import itertools
 import math
 import pathlib
 import re
-import sys
 import time
 from dataclasses import dataclass, field
 
 import numpy as np
 
+from gearrattle import reference as R
+
 HERE = pathlib.Path(__file__).resolve().parent
 ROOT = HERE.parents[1]
 FMU_PATH = ROOT / "target" / "fmu" / "GearRattle.fmu"
-if str(HERE) not in sys.path:
-    sys.path.insert(0, str(HERE))
-
-import reference as R  # noqa: E402
 
 FACTOR = 10.0  # the error may be up to FACTOR × the requested tolerance (issue 4)
 HOUR = 3600.0
