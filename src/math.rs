@@ -3,13 +3,10 @@
 //! against the standard library by its test). Knows nothing of gears or integrators.
 //!
 //! Why: in this crate's release build (LTO), `f64::cbrt` resolves to compiler_builtins'
-//! correctly rounded software cbrt and `sin_cos` to glibc's general routine; on the
-//! gear-rattle benchmark (S1) they took 25 % and 15 % of the profile samples. Measured on S1
-//! (1 s, rtol 1e-7, GearRattle alone, builds alternated 8 times): the run's median CPU time
-//! fell by about a fifth with the cube root below, then by 7 % more with the sine and cosine.
-//! The band's smoothing sin² is a polynomial on its argument's range ([`sin_squared`]): a
-//! general sine kernel compiled for baseline x86-64 had been 1 % slower there than glibc's
-//! FMA variant (dropped).
+//! correctly rounded software cbrt and `sin_cos` to glibc's general routine, both on the
+//! critical path of every right-hand side; these are cheaper there. The band's
+//! smoothing sin² is a polynomial on its argument's range ([`sin_squared`]), which needs no
+//! argument reduction. Figures: docs/DECISIONS.md, D8 and D13 to D15.
 
 /// Bits of the mantissa that index the tables of `cbrt`.
 const TABLE_BITS: u32 = 8;
@@ -239,8 +236,8 @@ const SIN_SQUARED: [f64; 13] = {
 /// π/2), summed by Estrin's scheme.
 ///
 /// Why not `f64::sin`: the band's factor lies on the critical path of every band RHS (the
-/// next stage waits for it), and glibc's sin, with its argument reduction and branches, was
-/// 6 % of perf's samples on S1; this one needs neither, the argument being within π/2.
+/// next stage waits for it), and glibc's sin has an argument reduction and branches; this
+/// one needs neither, the argument being within π/2 (docs/DECISIONS.md, D15).
 #[inline]
 pub fn sin_squared(x: f64) -> f64 {
     let c = &SIN_SQUARED;
@@ -257,8 +254,8 @@ pub fn sin_squared(x: f64) -> f64 {
 /// log2 x for a positive, finite, normal x, to 7.3e-4 absolute: x = 2^e·m with m ∈ [1, 2)
 /// taken apart from its bits, log2 m by a cubic (Chebyshev fit). For the step-size
 /// controller's powers of the error, where a relative error of 1e-4 in the step factor does
-/// not matter but latency does: the next step waits for the factor, and two `f64::powf`
-/// were slower on S1 (measured by A/B runs of the benchmark's profile). Zero gives −1025.
+/// not matter but latency does: the next step waits for the factor, which two `f64::powf`
+/// delay (docs/DECISIONS.md, D8). Zero gives −1025.
 #[inline]
 pub const fn log2_coarse(x: f64) -> f64 {
     const C: [f64; 4] = [

@@ -58,16 +58,11 @@ pub struct Verdict {
 ///
 /// The predictive step h²/h_acc · SAFETY · (err_acc / err²)^(1/5) extrapolates the trend of
 /// the error from one accepted step to the next, where the PI step only reads the error
-/// level. Through a smoothing band the contact stiffens with every step, so steps the PI
-/// controller grew were rejected: on S1 (1 s) the rejections fell from 411 to 185 at rtol
-/// 1.09e-5 with the cap, from 462 to 327 at 3.95e-6, and the error at rtol 1.1e-5 to 2e-5
-/// several-fold (`BENCH_DEBUG=gr` and `BENCH_PROFILE=1` of the work-precision bench, on
-/// 9883bd6 before the cap and 9a5d602 with it). At
-/// equal error the CPU did not move beyond the noise: where the error stays within 1e-9 m at
-/// the tolerance and at the tighter ones `make bench` probes (rtol about 4.0e-6 before,
-/// 4.8e-6 after), 2.68 ms before and 2.76 ms after, 8 runs each in alternation.
-/// The last accepted step is kept across edges: the first step into a band is then capped
-/// by how the previous band's last step went; forgetting it there gave no gain.
+/// level. Through a smoothing band the contact stiffens with every step, and the cap keeps
+/// the PI controller from growing steps that would then be rejected (fewer rejections and a
+/// lower error at loose tolerances; at equal error the CPU is unchanged: docs/DECISIONS.md,
+/// D7). The last accepted step is kept across edges: the first step into a band is then
+/// capped by how the previous band's last step went.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Controller {
     /// log2 of the last accepted step's error, which both controllers read, each with its

@@ -84,8 +84,8 @@ fn combine<const N: usize>(y: &[f64; N], h: f64, terms: &[(f64, &[f64; N])], m: 
 }
 
 /// Takes one step of size h from (t, y0), with k1 = f(t, y0) already known, into `out`
-/// (written in place: a step is about 50 numbers, and moving it around cost a twentieth of
-/// a run on S1).
+/// (written in place: a step is about 50 numbers, and returning it by value puts a copy on
+/// the stepping path; docs/DECISIONS.md, D9).
 ///
 /// Components `dynamic..N` are quadratures (∫ of a rate, like a dissipated energy) that
 /// the right-hand side does not read: the stages' arguments and the error estimate form only

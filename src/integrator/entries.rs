@@ -1,24 +1,13 @@
 //! The first DOPRI5 step into a piece after an edge. The step size carried over the edge is
-//! the one the old piece allowed, which can be far from what the new one allows: on the
-//! gear's bench scene S1 (rtol 1e-6), the first step into a smoothing band was often
-//! rejected and the first step into a contact accepted far below the tolerance (its
-//! controller then doubled it); the run's rejected steps fell from 1 056 to 568 with what
-//! follows (`BENCH_PROFILE=1` of the work-precision bench, on c6829eb^ and c6829eb). A piece is
+//! the one the old piece allowed, which can be far from what the new one allows. A piece is
 //! entered the same way again and again (a rattling gear enters each band from the gap and
 //! from the contact at every impact), so the solver remembers, per piece and per edge it was
 //! entered through, the ratio of the step size its controller wanted there to a base, and
 //! starts the next entry from the base times that ratio. The base is the time to cross the
 //! piece at the rate it is entered with where the piece is bounded (a band: ε/|ξ'|), else
-//! the step carried in. A band entered from the gap had carried the step of the DOPRI5 step
-//! before the free flight, unrelated to the band's crossing time; from the crossing time,
-//! S1's error (1 s) at rtol 1e-5 fell from 1.9e-9 to 3.1e-10 m (`BENCH_DEBUG=gr` of the
-//! bench, on b8235eb^ and b8235eb), the latter a dip of the error in rtol, it later proved.
-//! With the predictive controller of `control` too, over a grid of rtol of ratio 1.22, the
-//! crossing time keeps the error within 1e-9 m up to a looser tolerance than the step carried
-//! in (a throwaway build reverting the base; figures in issue 3's closing note of session 8):
-//! the non-smooth start of the band (the force grows like δ^(10/3) from the gap's edge) is
-//! where the error came from, and the error estimate of a step that starts there does not
-//! see it.
+//! the step carried in. From the crossing time the first step into a band stays short where
+//! the band starts non-smooth (the force grows like δ^(10/3) from the gap's edge), an error
+//! that the step's own estimate does not see. Evidence: docs/DECISIONS.md, D4 and D5.
 
 use serde::{Deserialize, Serialize};
 
