@@ -5,8 +5,8 @@
 //! - the collocation system is solved by a simplified Newton iteration in Hairer's
 //!   transformed variables W = (T⁻¹ ⊗ I) Z, which split the 3N×3N linear system into one real
 //!   N×N system with (γ/h) I − J and one complex N×N system with ((α + iβ)/h) I − J
-//!   (measured cheaper than the full 3N×3N system for every N from 2 to 7, see the test
-//!   `measure_linear_algebra`);
+//!   (cheaper than the full 3N×3N system, in the decompositions and in each iteration, for
+//!   every N from 2 to 7: docs/DECISIONS.md, D17);
 //! - the Jacobian J = ∂f/∂y comes from the system ([`Jacobian`]); it is kept from step to step
 //!   while the Newton iteration contracts fast (θ ≤ 0.001), and the two LU decompositions
 //!   are kept while J and h stay (the controller keeps h when it would grow by less than 20 %);
@@ -641,31 +641,29 @@ impl<const N: usize> Stepper<N> {
     }
 }
 
-/// The Butcher matrix of the 3-stage Radau IIA method in closed form (Hairer & Wanner, IV.5),
-/// for the tests that check the constants and time the algebra.
-#[cfg(test)]
-fn butcher() -> [[f64; 3]; 3] {
-    let s6 = 6f64.sqrt();
-    [
-        [
-            (88.0 - 7.0 * s6) / 360.0,
-            (296.0 - 169.0 * s6) / 1800.0,
-            (-2.0 + 3.0 * s6) / 225.0,
-        ],
-        [
-            (296.0 + 169.0 * s6) / 1800.0,
-            (88.0 + 7.0 * s6) / 360.0,
-            (-2.0 - 3.0 * s6) / 225.0,
-        ],
-        [(16.0 - s6) / 36.0, (16.0 + s6) / 36.0, 1.0 / 9.0],
-    ]
-}
-
 #[cfg(test)]
 #[allow(clippy::needless_range_loop)]
 mod tests {
     use super::*;
     use crate::integrator::test_systems::{Nonlinear, Robertson, sci, tolerance};
+
+    /// The Butcher matrix of the 3-stage Radau IIA method in closed form (Hairer & Wanner, IV.5).
+    fn butcher() -> [[f64; 3]; 3] {
+        let s6 = 6f64.sqrt();
+        [
+            [
+                (88.0 - 7.0 * s6) / 360.0,
+                (296.0 - 169.0 * s6) / 1800.0,
+                (-2.0 + 3.0 * s6) / 225.0,
+            ],
+            [
+                (296.0 + 169.0 * s6) / 1800.0,
+                (88.0 + 7.0 * s6) / 360.0,
+                (-2.0 - 3.0 * s6) / 225.0,
+            ],
+            [(16.0 - s6) / 36.0, (16.0 + s6) / 36.0, 1.0 / 9.0],
+        ]
+    }
 
     #[test]
     fn constants_diagonalise_the_butcher_matrix() {
@@ -757,144 +755,5 @@ mod tests {
             st.stats.decompositions,
             restored.stats.decompositions
         );
-    }
-}
-
-/// Cost of the linear algebra of one Newton iteration and of one decomposition: Hairer's
-/// transformed system (real N×N + complex N×N) against the full 3N×3N real system
-/// (I − h A⊗J) ΔZ = −Z + h (A⊗I) F, which also needs (γ/h) I − J for the error estimate.
-/// `cargo test --release --lib measure_linear_algebra -- --ignored --nocapture`
-#[cfg(test)]
-mod measure {
-    use super::*;
-    use nalgebra::{LU, SVector};
-    use std::hint::black_box;
-    use std::time::Instant;
-
-    fn random<const N: usize>(seed: &mut u64) -> [[f64; N]; N] {
-        let mut j = [[0.0; N]; N];
-        for row in j.iter_mut() {
-            for v in row.iter_mut() {
-                *seed = seed
-                    .wrapping_mul(6364136223846793005)
-                    .wrapping_add(1442695040888963407);
-                *v = ((*seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 2e3;
-            }
-        }
-        j
-    }
-
-    /// Nanoseconds per call of f, best of 40 rounds (short rounds: a shared machine).
-    fn time(reps: u32, mut f: impl FnMut()) -> f64 {
-        (0..40)
-            .map(|_| {
-                let start = Instant::now();
-                for _ in 0..reps {
-                    f();
-                }
-                start.elapsed().as_nanos() as f64 / reps as f64
-            })
-            .fold(f64::INFINITY, f64::min)
-    }
-
-    macro_rules! measure {
-        ($n:literal, $n3:literal) => {{
-            const N: usize = $n;
-            let mut seed = 42u64;
-            let j: [[f64; N]; N] = random(&mut seed);
-            let h = 1e-2;
-            let a = butcher();
-            let reps = 10_000;
-            let f: [[f64; N]; 3] = [random::<N>(&mut seed)[0], random::<N>(&mut seed)[0], random::<N>(&mut seed)[0]];
-
-            // Transformed: decompositions.
-            let dec_t = time(reps, || {
-                black_box(Factors::new(black_box(&j), black_box(h)));
-            });
-            let e1 = SMatrix::<f64, N, N>::from_fn(|r, c| (if r == c { GAMMA / h } else { 0.0 }) - j[r][c]);
-            let dec_nalgebra = time(reps, || {
-                black_box(LU::new(black_box(e1)));
-            });
-            let dec_ours = time(reps, || {
-                black_box(Lu::new(black_box(e1)));
-            });
-            // Transformed: one Newton iteration's algebra (T⁻¹ F, two solves, W += ΔW, Z = T W).
-            let fac = Factors::new(&j, h).unwrap();
-            let mut w = [[0.0; N]; 3];
-            let mut z = [[0.0; N]; 3];
-            let (fac1, alphn, betan) = (GAMMA / h, ALPHA / h, BETA / h);
-            let it_t = time(reps, || {
-                let (r1, r23) = fac.newton_increment(black_box(&f), &w, (fac1, alphn, betan));
-                apply_increment(&mut w, &mut z, &r1, &r23);
-                // Kept bounded over the repetitions.
-                for v in w.iter_mut().flatten() {
-                    *v *= 1e-3;
-                }
-                black_box(&z);
-            });
-
-            // Full 3N×3N: decomposition (nalgebra's LU on the stack, concrete size) plus the
-            // real N×N one the error estimate needs.
-            let full = SMatrix::<f64, $n3, $n3>::from_fn(|r, c| {
-                let (si, i, sj, jj) = (r / N, r % N, c / N, c % N);
-                (if r == c { 1.0 } else { 0.0 }) - h * a[si][sj] * j[i][jj]
-            });
-            let dec_f = time(reps, || {
-                black_box(LU::new(black_box(full)));
-                black_box(Lu::new(black_box(e1)));
-            });
-            let dec_f_ours = time(reps, || {
-                black_box(Lu::<f64, $n3>::new(black_box(full)));
-                black_box(Lu::new(black_box(e1)));
-            });
-            // Full: one Newton iteration (residual −Z + h (A⊗I) F, one 3N solve, Z += ΔZ).
-            let residual = |zf: &[f64; $n3], f: &[[f64; N]; 3]| {
-                let mut g = [0.0; $n3];
-                for s in 0..3 {
-                    for i in 0..N {
-                        g[s * N + i] = -zf[s * N + i]
-                            + h * (a[s][0] * f[0][i] + a[s][1] * f[1][i] + a[s][2] * f[2][i]);
-                    }
-                }
-                g
-            };
-            let lu = Lu::<f64, $n3>::new(full).unwrap();
-            let mut zf = [0.0; $n3];
-            let it_f = time(reps, || {
-                let mut g = residual(&zf, black_box(&f));
-                lu.solve(&mut g);
-                for k in 0..$n3 {
-                    zf[k] = 1e-3 * (zf[k] + g[k]);
-                }
-                black_box(&zf);
-            });
-            let lu_n = LU::new(full);
-            let it_f_nalgebra = time(reps, || {
-                let mut g = SVector::<f64, $n3>::from(residual(&zf, black_box(&f)));
-                lu_n.solve_mut(&mut g);
-                for k in 0..$n3 {
-                    zf[k] = 1e-3 * (zf[k] + g[k]);
-                }
-                black_box(&zf);
-            });
-            println!(
-                "| {N} | {dec_t:.0} | {it_t:.0} | {dec_f:.0} ({dec_f_ours:.0}) | {it_f_nalgebra:.0} ({it_f:.0}) | {dec_nalgebra:.0} / {dec_ours:.0} |"
-            );
-        }};
-    }
-
-    #[test]
-    #[ignore]
-    fn measure_linear_algebra() {
-        println!(
-            "| N | transformed: LU pair [ns] | transformed: Newton iteration [ns] | full 3N: LU + error LU [ns] nalgebra (ours) | full 3N: Newton iteration [ns] nalgebra (ours) | N×N real LU: nalgebra / ours [ns] |"
-        );
-        println!("|---|---|---|---|---|---|");
-        measure!(2, 6);
-        measure!(3, 9);
-        measure!(4, 12);
-        measure!(5, 15);
-        measure!(6, 18);
-        measure!(7, 21);
     }
 }
