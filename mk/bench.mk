@@ -1,4 +1,4 @@
-# Work-precision benchmark (issue 3): `make bench` measures GearRattle beside its peers and
+# Work-precision benchmark: `make bench` measures GearRattle beside its peers and
 # regenerates docs/BENCHMARKS.md and docs/work_precision.png. Not part of `make test`: it
 # takes 12-16 min on the 2-core machine (about 8 more when the reference is rebuilt) and makes
 # no timed assertion.
@@ -11,7 +11,7 @@ BENCH_REF := $(BENCH_DIR)/reference/scenes.csv
 
 .PHONY: bench bench-reference bench-profile
 
-## bench: work-precision benchmark of issue 3 -> docs/BENCHMARKS.md, docs/work_precision.png
+## bench: work-precision benchmark -> docs/BENCHMARKS.md, docs/work_precision.png
 bench: fmu $(VENV)/.installed $(BENCH_REF) | libclang
 	@started=$$(date +%s); \
 	mkdir -p $(BENCH_DIR); \

@@ -1,4 +1,4 @@
-"""Python peers of the work-precision benchmark (issue 3): scipy's solve_ivp on the same
+"""Python peers of the work-precision benchmark: scipy's solve_ivp on the same
 equations, and the GearRattle FMU through fmpy, the way users script them.
 
     .venv/bin/python scripts/bench_python.py [--scenes S1-1s,...] [--quick] [--out target/bench/python.csv]
@@ -8,7 +8,7 @@ Needs target/bench/reference/ (scripts/bench_reference.py) and target/fmu/GearRa
 * scipy: solve_ivp with RK45, DOP853, Radau and LSODA, rtol 1e-3 ... 1e-10, atol = rtol times
   (G, G times the contact frequency) as for every solver of the benchmark, the energies
   carried as quadratures outside the error control (atol 1e30). The right-hand side is the
-  one of tests/python/reference.py (`_make_rhs`, the region's formula locked), so these are
+  one of python/gearrattle/reference.py (`_make_rhs`, the region's formula locked), so these are
   the same equations as the reference, written independently of the FMU. Region changes are
   solve_ivp terminal events on the two edges of the current region (xi = lo falling, xi = hi
   rising; the levels 1e-13 G outside the edges, else a piece that starts on its edge and turns

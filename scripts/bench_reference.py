@@ -1,10 +1,10 @@
-"""Reference solutions of the work-precision benchmark (issue 3), from the independent Python
-implementation of MODEL.md (tests/python/reference.py, reused as it is).
+"""Reference solutions of the work-precision benchmark, from the independent Python
+implementation of MODEL.md (python/gearrattle/reference.py, reused as it is).
 
     .venv/bin/python scripts/bench_reference.py [--out target/bench/reference]
 
-For each base scene (S1, S2, S3 of MODEL.md §5 and two stiff variants of S1 from issue 4) it
-computes, with the paper's parameters, xi(0) = G/2, xi'(0) = 0:
+For each base scene (S1, S2, S3 of MODEL.md §5 and two stiff variants of S1 from the stress
+suite) it computes, with the paper's parameters, xi(0) = G/2, xi'(0) = 0:
 
 * the reference: reference.simulate at tight tolerance (DOP853 rtol 1e-13 for S1-S3; Radau
   rtol 1e-12 for the stiff variants, where DOP853 needs millions of steps), sampled on the 1 ms
@@ -41,7 +41,7 @@ BASES = {
     "S1": dict(scene="S1", over={}, t_end=1.0, ref=("DOP853", 1e-13), check=("Radau", 1e-12)),
     "S2": dict(scene="S2", over={}, t_end=1.0, ref=("DOP853", 1e-13), check=("Radau", 1e-12)),
     "S3": dict(scene="S3", over={}, t_end=1.0, ref=("DOP853", 1e-13), check=("Radau", 1e-12)),
-    # issue 4's stiff cases: a 1e4 times lighter loose gear; 1000 times the contact damping
+    # The stress suite's stiff cases: a 1e4 times lighter loose gear; 1000 times the contact damping
     "S1-IL": dict(scene="S1", over=dict(I_L=0.32e-7), t_end=0.2, ref=("Radau", 1e-12), check=("DOP853", 1e-12)),
     "S1-CLM": dict(scene="S1", over=dict(C_LM=67000.0), t_end=0.2, ref=("Radau", 1e-12), check=("DOP853", 1e-12)),
 }

@@ -1,5 +1,7 @@
 """Merges the work-precision CSVs of `make bench` into docs/work_precision.png and
-docs/BENCHMARKS.md (issue 3).
+docs/BENCHMARKS.md. The report holds only what the run measured (tables, verdicts computed
+from the CSVs, the machine, the commands); the decisions behind the integrator and the levers
+measured and dropped are in docs/DECISIONS.md, which the report links to.
 
     .venv/bin/python scripts/bench_report.py [--started EPOCH_SECONDS]
 
@@ -28,7 +30,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 BENCH = ROOT / "target" / "bench"
-TARGET = 1e-9  # m: the error at which issue 3's targets are set (S1)
+TARGET = 1e-9  # m: the error at which the targets are set (S1)
 GR = "GearRattle (direct)"
 EQUAL_SUITE = "rust-equal-error"
 FMU_C = "GearRattle FMU (C API)"
@@ -321,30 +323,10 @@ def analysis(rows, s1, r_rust, n_rust, r_user, n_user, r_py, n_py, comm_rows, to
               f"reached at a Taylor step's polynomial or on the exact flight, at no extra RHS), rejected steps "
               f"{p['reject_pct']:.0f} %.")
             a("")
-            a("Levers of issue 3 in place: steps end on the band edges; the gap is crossed in closed form (a root "
-              "search on the exact free flight that cannot step over a crossing); the full contacts are crossed by "
-              "Taylor-series steps of order 11 (`integrator::taylor`, `physics::series`: where δ stays at least ε "
-              "from the kink of δ^(4/3) the coefficients follow by the recurrence of a power, a step is as long as "
-              "its last two terms allow, and its polynomial is its own dense output, so an edge needs no redone "
-              "step; no division on the terms' chain, the power's sums taking the newest term last, the power "
-              "flows' series by unrolled Cauchy products); a cheap right-hand side (table "
-              "cube root, the excitation's sine and cosine by fdlibm's kernels, inlined, the band's sin² as a polynomial, no powf for "
-              "α = 4/3); no allocation on the stepping path (each DOPRI5 step written in place); the stages form "
-              "only ξ and ξ' (the energy quadratures advance at the step's end); the first step into a piece "
-              "is sized from the piece's crossing time (a band: ε/|ξ'|, where the step carried over the edge had "
-              "left S1's error at loose tolerances several-fold higher: the bands' non-smooth starts are where "
-              "it comes from) times what the earlier entries into it taught the step-size controller "
-              "(`entries`); the PI step-size controller capped by Gustafsson's predictive one (through a "
-              "band the contact stiffens step after step, which the PI controller does not foresee: on S1 1 s "
-              "its rejections fell from 411 to 185 at rtol 1.09e-5 and from 462 to 327 at 3.95e-6, and the error at rtol 1.1e-5 "
-              "to 2e-5 several-fold; but the rtol where GearRattle reaches 1e-9 m with the probes tighter went "
-              "only from about 4.0e-6 to 4.8e-6, and the CPU there is unchanged within the noise: 2.68 ms "
-              "before, 2.76 ms after, 8 runs each in alternation; `BENCH_DEBUG=gr` and `BENCH_PROFILE=1` on "
-              "9883bd6 and 9a5d602); the step-size controller's "
-              "powers by a coarse log2/exp2; the free flight's start computed once per passage; no division on "
-              "the path of a stage or of a flight's point (1/r_L, 1/I_L, A/w, A/w², 1/λ kept); outputs computed "
-              "only when read. What is left, with the most each could give here (the share it could remove, as "
-              "a speed-up bound):")
+            a("What is left, with the most each lever could give in this run (the share of the time it could "
+              "remove, as a speed-up bound; a cheaper right-hand side moves the ratio against the peers as users "
+              "write them, not against those that call GearRattle's own). The levers in place, and those measured "
+              "and dropped, are in [DECISIONS.md](DECISIONS.md).")
             a("")
             levers = [
                 ("a cheaper right-hand side (all RHS time; by region: " +
@@ -379,71 +361,8 @@ def analysis(rows, s1, r_rust, n_rust, r_user, n_user, r_py, n_py, comm_rows, to
 
             libm = {k: v for k, v in perf.items() if k.startswith("__") and v >= 1}
             if perf:
-                a("What the profile says: the right-hand side (with the cube root and the excitation's sine and "
-                  "cosine inlined into it), the DOPRI5 step and the contact's Taylor series (`series`) are the bulk. "
-                  "Library calls above 1 %: " +
+                a("Library calls above 1 % of perf's samples: " +
                   (", ".join(f"{k} {v:.0f} %" for k, v in libm.items()) if libm else "none") + ".")
-                a("")
-                a("Against the integrator-only peers the RHS lever does not move the ratio, since they call the "
-                  "same RHS; it moves it against the peers as users write them, and it moves the absolute cost, "
-                  "which is what a user sees. Against peers with the same RHS and the same edge handling, 3× would "
-                  "take fewer steps inside the contacts and bands, where the steps now are (MODEL.md: higher orders "
-                  "did not pay, each band crossing costs 2-3 steps whatever the order). The Taylor steps took the "
-                  "full contacts; the bands are still DOPRI5's. Their force s(δ)·K* δ|δ/G|^(α−1) has Taylor "
-                  "series in t wherever δ ≠ 0, but they converge only up to the time the trajectory takes to reach "
-                  "δ = 0, the branch point of |δ|^(α−1): with 12 terms and these weights a step covers at most "
-                  "about a third of the way left to the gap's edge (the length rule (SHARE·w/|δ|)^(1/11), an "
-                  "estimate, not a measurement), so Taylor steps would never reach that edge and would spend "
-                  "about as many steps on the band's inner half as DOPRI5 spends on the whole band (3.1 accepted "
-                  "and 0.55 rejected steps per band at rtol 4.8e-6, `BENCH_PROFILE=1`). The substitution "
-                  "ξ = g + s·w³ (g the band's edge with the gap, s = ±ε) makes the band's force analytic in w "
-                  "(δ|δ/G|^(1/3) ∝ w⁴, s = sin²(πw³/2)), and a passage integrated in w (t and the rest of the "
-                  "state as functions of w, dt/dw = 3s·w²/ξ') ends exactly on both edges, with no edge search "
-                  "and no redone step. Prototypes of it (not kept; their figures are in issue 3's closing note "
-                  "of session 9) did not pay: with DOPRI5 in w, over the whole band or only over its end "
-                  "towards the gap, the error estimate failed (the force in w is close to a polynomial of high "
-                  "degree, like w¹⁰ at the gap's edge, which DOPRI5's 5th- and 4th-order solutions miss "
-                  "alike), so S1's error rose several-fold at equal tolerance and the CPU did not fall; with "
-                  "DOP853 in w (a scipy study of S1's band passages) a band cost as many RHS as DOPRI5 in t "
-                  "spends on it now (28.6: 17 067 RHS over 596 bands at rtol 4.8e-6). Where S1's "
-                  "error comes from (`BENCH_DEBUG=gr`, on 645c384): at rtol 4.8e-6 and 8.9e-6 "
-                  "its level is set by one passage, the last impact of the F+ run that ends at t ≈ 52 ms, whose "
-                  "exit speed is off by about 2.6e-7 m/s (3e-5 of it); the 2.5-ms flight across the gap turns "
-                  "that into 8.6e-10 m by t = 55 ms (at 8.9e-6), and the error stays at that level, 0.5-1.3e-9 m, "
-                  "over the next 150 ms, where its maximum falls (t ≈ 89 ms). At 1.09e-5 the same passage comes "
-                  "out several times more accurate (1.5e-10 m at 56 ms), which is why the error is not monotone "
-                  "in the tolerance. Tried and "
-                  "dropped (code not kept; their figures are in issue 3's closing notes of sessions 4 to 9): crossing an "
-                  "edge at the straddling step's dense output instead of redoing the step (fewer RHS, but three "
-                  "cases of the stress suite, make stability, failed, among them ε = 0 and the energy balance); "
-                  "aiming each step that would cross an edge to end just past it and crossing at its dense output "
-                  "(fewer RHS, CPU unchanged within the A/B's noise); adding the newest stage last in each stage's "
-                  "sum (slower); regrouping ξ'' so that the contact force enters by one multiply and one "
-                  "subtraction, and the step-size control on the error's mean square without the square root "
-                  "(each a few per cent, within the noise); the stages' loops over a count of dynamic components "
-                  "fixed at compile time (slower on S1); the excitation's sine and cosine at a step's stages "
-                  "rotated from those at the step's start, one sin_cos per step instead of six (CPU unchanged "
-                  "within the noise; likely because they do not depend on the state, so the processor computes them "
-                  "alongside the stages' chain of dependent operations rather than on it); 16 terms instead of 12 "
-                  "in the Taylor steps once a series had become cheaper (within the noise at 1e-9 m); a tenth of the "
-                  "share of the error weights for the Taylor steps' truncation, SHARE 0.01 (the error at each "
-                  "tolerance fell by about a tenth only, so on S1 it comes mostly from the bands' DOPRI5 steps; "
-                  "slower at equal error); crossing a band → contact edge at the straddling step's dense output, where a "
-                  "Taylor step follows (the errors 2.5× higher at each tolerance, no gain at equal error); the "
-                  "edge search's dense output formed once per search instead of once per evaluation (CPU "
-                  "unchanged: the search takes 8 evaluations on average, and the Taylor steps' searches dominate); "
-                  "the DOPRI5 error 3 or 10 times tighter in the bands entered from the gap alone, or in those "
-                  "entered from the contact alone (the error at equal RHS no lower: neither kind of band passage "
-                  "holds the error alone); the first step into a band 0.7, 0.85 or 1.2 times the learnt one (with "
-                  "the predictive controller: fewer rejections at 0.7, but the error at each tolerance 2-5× "
-                  "higher); forgetting the predictive controller's last step at each edge (no gain); a larger "
-                  "share of the error weights for the Taylor steps' truncation, SHARE 0.3 or 1.0 in "
-                  "src/integrator/taylor.rs (fewer Taylor steps, but S1's error higher at nearly every tolerance "
-                  "of a √1.5 grid from 3e-5 to 1.2e-6, by `BENCH_DEBUG=gr`: at rtol 4.8e-6, 1.5e-9 and 2.4e-9 m "
-                  "against 9.9e-10 m, so the contacts' share of the error is not negligible above SHARE 0.1); "
-                  "the power flows' squares ξ'² and slip² in the Taylor steps by a symmetric product, half their "
-                  "multiply-adds (CPU unchanged within the noise of alternated runs: the products overlap the "
-                  "series' chain of dependent operations).")
                 a("")
     if comm_rows:
         key = [cr for cr in comm_rows if tol_1e9 and math.isclose(cr[0], tol_1e9)] or comm_rows[:1]
@@ -621,8 +540,9 @@ def main() -> None:
     w("# Work-precision benchmark: GearRattle beside its peers")
     w("")
     w("Generated by `make bench` (scripts/bench_report.py) from target/bench/rust.csv and "
-      "target/bench/python.csv; do not edit by hand: rerun `make bench`. Issue 3. "
-      "Ratios, not absolute times, carry the claims.")
+      "target/bench/python.csv; do not edit by hand: rerun `make bench`. "
+      "Ratios, not absolute times, carry the claims. Why the integrator is built as it is, and the levers "
+      "measured and dropped: [DECISIONS.md](DECISIONS.md).")
     w("")
     w("![work-precision](work_precision.png)")
     w("")
@@ -632,10 +552,9 @@ def main() -> None:
         w("Each integrator at the loosest tolerance found where its error is within 1e-9 m there and at 1.22, "
           "1.5, 1.83 and 2.25 times tighter, then all run round-robin in one group, repeat after repeat: the ratios come from "
           "one stretch of time on this noisy machine, with no interpolation between groups run minutes apart. "
-          "The tighter probes are there because errors are not monotone in the tolerance: GearRattle's on S1 1 s "
-          "was 3.1e-10 m at rtol 1e-5 but 1.5e-9 m at 8e-6 and 5e-6 and 2.0e-9 m at 1.2e-5 (on 7d5bb2d, "
-          "`BENCH_DEBUG=gr BENCH_DEBUG_SCENE=S1-1s BENCH_DEBUG_RTOL=r` of the bench binary), and a tolerance in "
-          "such a dip is not one a user could aim for without the reference. The tolerance is found from the "
+          "The tighter probes are there because errors are not monotone in the tolerance, and a tolerance in "
+          "a dip of the error is not one a user could aim for without the reference ([DECISIONS.md](DECISIONS.md), "
+          "D18). The tolerance is found from the "
           "loosest one of the sweep that passes, by bisection in log rtol towards the sweep's next looser one "
           "(6 steps, so within 2 % of the solver's own threshold). A solver can still land below 1e-9 m (its "
           "ratio is then an upper bound of its cost at 1e-9 m). GearRattle's RHS count leaves out its Taylor "
@@ -681,7 +600,7 @@ def main() -> None:
           else f"| {s} | {fmt_t(c)}{note} | - | {ratio} |")
     w("")
 
-    w("## Targets of issue 3")
+    w("## Targets")
     w("")
     w("| target | measured | verdict |")
     w("|---|---|---|")
@@ -722,10 +641,6 @@ def main() -> None:
                r_user if q_user is None else q_user, n_user if q_user is None else n_q_user, r_py if r_py is not None else r_py_s, n_py if r_py is not None else n_py_s,
                comm_rows, tol_1e9))
     w("")
-    notes_path = ROOT / "docs" / "bench_notes.md"
-    if notes_path.is_file():
-        w(notes_path.read_text().strip())
-        w("")
 
     # ---- machine and commands
     w("## Machine, noise, commands")
@@ -746,7 +661,7 @@ def main() -> None:
         w(f"- Wall time of this `make bench`: {wall / 60:.1f} min.")
     w("- Commands (one does all): `make bench`, which runs")
     w("  1. `make fmu` (target/fmu/GearRattle.fmu);")
-    w("  2. `.venv/bin/python scripts/bench_reference.py` (only when it or tests/python/reference.py changed: "
+    w("  2. `.venv/bin/python scripts/bench_reference.py` (only when it or python/gearrattle/reference.py changed: "
       "target/bench/reference/; about 8 minutes more, mostly the Radau checks);")
     w("  3. `cargo bench -p gear_rattle_bench --bench work_precision` (target/bench/rust.csv; `BENCH_QUICK=1` for a smoke run, "
       "`BENCH_SCENES=S1-1s,...` for a subset);")
@@ -760,10 +675,10 @@ def main() -> None:
     w("## What is measured")
     w("")
     w("- Scenes (MODEL.md §5, paper parameters, ξ(0) = G/2, ξ'(0) = 0): S1 30 Hz / 300 rad/s² RMS, "
-      "S2 60 Hz / 300, S3 30 Hz / 500, each over 0.2 s and 1 s; and two stiff variants of S1 from issue 4 "
+      "S2 60 Hz / 300, S3 30 Hz / 500, each over 0.2 s and 1 s; and two stiff variants of S1 from the stress suite "
       "over 0.2 s: S1-IL (I_L = 0.32e-7 kg m², 1e4 times lighter) and S1-CLM (C_LM × 1000).")
     w("- Error: max |Δξ| on a 1 ms grid over the predictable window, against an independent reference "
-      "(tests/python/reference.py, DOP853 at rtol 1e-13 for S1-S3, Radau at 1e-12 for the stiff variants), "
+      "(python/gearrattle/reference.py, DOP853 at rtol 1e-13 for S1-S3, Radau at 1e-12 for the stiff variants), "
       "checked by a second method; RMS of the pitch-line speed error (Δξ', as r_L ω_L = ξ' + r_M ω_M) in the CSV. "
       "The FMU at 10 ms is compared on its 10 ms points.")
     w("- Predictable window: the reference rerun from ξ(0) + 1e-4·G; the window ends where the two differ by "
@@ -789,8 +704,7 @@ def main() -> None:
       "(Newton on the step length while ξ misses the edge by more than 0.1·rtol·G), restart in the neighbouring "
       "region with the step size proposed before. Outputs: steps end on the 1 ms grid points, as GearRattle's do "
       "(the crates' dense outputs are not used for the state: those of differential-equations 0.7 are of lower "
-      "order than its methods, measured on y'' = −y with fixed steps: DOPRI5's interpolant errs 20× Hairer's at "
-      "h = 0.05, DOP853's 4e-8 inside steps against 1e-12 at their ends at h = 0.2). differential-equations is "
+      "order than its methods, [DECISIONS.md](DECISIONS.md) D20). differential-equations is "
       "stepped through OrdinaryNumericalMethod (its DOPRI5 evaluates f(y1) again after each accepted step: 7 RHS "
       "per step; DOP853 12 + 3 for its dense output; each restart costs one RHS in `init`); diffsol's ERK (Tsit45, "
       "nalgebra vectors) through OdeSolverMethod::step, set_stop_time and state_mut. "
