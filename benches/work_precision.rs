@@ -1,4 +1,4 @@
-//! Work-precision benchmark of issue 3: error against CPU time for the GearRattle integrator
+//! Work-precision benchmark: error against CPU time for the GearRattle integrator
 //! called directly, the FMU through its C API, and maintained Rust ODE crates on the same
 //! equations, measured side by side (interleaved repeats) in one run. On S1 the integrators
 //! then run once more side by side, each at the tolerance where its error is within 1e-9 m
@@ -6,10 +6,11 @@
 //!
 //!     cargo bench -p gear_rattle_bench --bench work_precision          (or `make bench`, which runs everything)
 //!
-//! Needs the reference of `scripts/bench_python.py reference` (target/bench/reference/: the
-//! scenes, their predictable windows and an independent tight solution on a 1 ms grid) and
-//! the FMU (`make fmu`). Writes target/bench/rust.csv and prints a summary. Timed assertions
-//! are not made: the figures are printed and judged in docs/BENCHMARKS.md.
+//! Needs the reference of `scripts/bench_reference.py` (`make bench-reference`;
+//! target/bench/reference/: the scenes, their predictable windows and an independent tight
+//! solution on a 1 ms grid) and the FMU (`make fmu`). Writes target/bench/rust.csv and prints
+//! a summary. Timed assertions are not made: the figures are printed and judged in
+//! docs/BENCHMARKS.md.
 //!
 //! Environment: BENCH_QUICK=1 (one scene, three tolerances, one repeat: a smoke run),
 //! BENCH_SCENES=S1-1s,S2-0.2s (a subset), BENCH_BUDGET=seconds of CPU per group of
@@ -38,7 +39,7 @@ use gear_rattle::physics::{Dynamics, Excitation, GearParams, Sine};
 use gear_rattle::rattle::{N, Rattle, State, XI, XI_DOT};
 use peers::{Model, Run, Stepper};
 
-/// The tolerance sweep of issue 3.
+/// The tolerance sweep: every half decade from 1e-3 to 1e-10.
 const TOLS: [f64; 15] = [
     1e-3, 3e-4, 1e-4, 3e-5, 1e-5, 3e-6, 1e-6, 3e-7, 1e-7, 3e-8, 1e-8, 3e-9, 1e-9, 3e-10, 1e-10,
 ];
@@ -52,12 +53,12 @@ fn fmu_tolerance(rtol: f64) -> bool {
 const COMM_STEPS: [f64; 4] = [1e-2, 1e-3, 1e-4, 1e-5];
 /// Spacing of the error grid (the reference is sampled there).
 const GRID: f64 = 1e-3;
-/// Error level at which solvers are compared (issue 3: 1e-9 m = 4e-5 G on S1).
+/// Error level at which solvers are compared, that of the targets: 1e-9 m = 4e-5 G on S1.
 const TARGET_ERROR: f64 = 1e-9;
 /// A tolerance counts as reaching [`TARGET_ERROR`] when the runs at it and at these factors
 /// tighter do (see [`equal_error_configs`]): steps of 1.22 over most of the factor 3.2 to the
-/// sweep's next tolerance. With steps of 1.5 GearRattle passed at rtol 1.09e-5 on S1 1 s
-/// while its error at 8.9e-6 was 1.3e-9 m.
+/// sweep's next tolerance, fine enough not to step over a dip of the error in rtol
+/// (docs/DECISIONS.md, D18).
 const PROBES: [f64; 5] = [1.0, 1.22, 1.5, 1.83, 2.25];
 /// Scenes where the integrators also run side by side at equal error (each at the tolerance
 /// that brings its error within [`TARGET_ERROR`]), with this budget of CPU seconds and at most
@@ -106,7 +107,7 @@ fn cpu_now() -> f64 {
 }
 
 // ---------------------------------------------------------------------------------------
-// Scenes and reference (from scripts/bench_python.py reference)
+// Scenes and reference (from scripts/bench_reference.py)
 // ---------------------------------------------------------------------------------------
 
 #[derive(Clone, Debug)]
@@ -680,7 +681,7 @@ fn csv_row(suite: &str, sc: &Scene, r: &Reference, m: &Measured) -> String {
 }
 
 // ---------------------------------------------------------------------------------------
-// Equal-error comparison (the targets of issue 3 are at 1e-9 m on S1)
+// Equal-error comparison (the targets are set at 1e-9 m on S1)
 // ---------------------------------------------------------------------------------------
 
 /// The value (CPU time, or tolerance) at error `target`, interpolated log-log between the two
@@ -700,9 +701,9 @@ fn at_error(points: &[(f64, f64)], target: f64) -> Option<(f64, bool)> {
 
 /// Each integrator at the loosest tolerance found where its error on `sc` is at most
 /// [`TARGET_ERROR`] there and at the tolerances [`PROBES`] times tighter, for a group run side
-/// by side. Errors are not monotone in the tolerance: GearRattle's on S1 1 s was 3.1e-10 m at
-/// rtol 1e-5 but 1.5e-9 m at 8e-6 and 5e-6 (on 7d5bb2d), and a tolerance that falls in such a
-/// dip is one a user could not choose without the reference in hand. The loosest tolerance
+/// by side. Errors are not monotone in the tolerance, and a tolerance that falls in a dip of
+/// the error is one a user could not choose without the reference in hand (docs/DECISIONS.md,
+/// D18). The loosest tolerance
 /// of the sweep that passes this test, then bisection (in log rtol, 6 steps) towards the
 /// sweep's next looser tolerance, so that every solver ends within 2 % in rtol of its own
 /// threshold. Solvers that never reach it are left out; one within it at the loosest

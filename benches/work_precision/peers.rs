@@ -16,11 +16,9 @@
 //!
 //! Why steps end on edges and grid points rather than using the crates' dense outputs for the
 //! state: the dense outputs of differential-equations 0.7 are of lower order than its methods
-//! (measured on y'' = −y with fixed steps: DOPRI5's interpolant errs O(h⁴) per step, 20 times
-//! Hairer's at h = 0.05; DOP853's O(h⁵), 4e-8 inside steps against 1e-12 at their ends at
-//! h = 0.2), which would charge an interpolation defect to the method. The crates' event APIs
-//! (differential-equations' `Event`, diffsol's root functions) watch sign changes at step ends
-//! only and would skip a grazing contact; they are not used.
+//! (docs/DECISIONS.md, D20), which would charge an interpolation defect to the method. The
+//! crates' event APIs (differential-equations' `Event`, diffsol's root functions) watch sign
+//! changes at step ends only and would skip a grazing contact; they are not used.
 //!
 //! The second kind of peer is the crate as a user would use it after reading MODEL.md: the
 //! right-hand side written literally from it ([`UserRhs`]: powf for |δ/G|^(α−1), the band's

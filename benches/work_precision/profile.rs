@@ -4,7 +4,7 @@
 //! breakdown of its work: right-hand sides per region (counted through a wrapper of `Rattle`,
 //! the solver being generic over the system), the measured cost of one right-hand side in each
 //! region, hence the share of the time spent in right-hand sides, and the evaluations spent on
-//! edges and rejected steps. This is what says which lever of issue 3 would pay.
+//! edges and rejected steps: what bounds the gain of each lever (docs/BENCHMARKS.md).
 
 use super::*;
 use gear_rattle::integrator::taylor::Coefficients;
