@@ -1,44 +1,39 @@
 """GearRattle rattle map: the paper's sweep (Dion et al. 2009, section 8: 30-60 Hz in 2 Hz steps
 x 100-700 rad/s^2 RMS) through the FMU, as heat maps, plus the no-impact threshold vs frequency.
 
-    .venv/bin/python scripts/rattle_map.py [--fmu PATH] [--out DIR] [--workers 2] ...
+    .venv/bin/python scripts/rattle_map.py [--fmu PATH] [--out DIR] [--workers N] ...
 
-Every grid point is one fmpy simulate_fmu run of the FMU in sine mode (excitation = 1, f_exc,
-A_rms; all other parameters at the FMU's start values = the paper's), from the bench start
-(xi = G/2, xi' = 0). Statistics over the same steady window as scripts/demo.py (0.2 s to the
-end of a 1 s run), so the S1/S2/S3 cells can be read against `make demo`.
+The points run on the study runner (gearrattle.study, docs/STUDIES.md): Dask workers, one FMU
+instance each, every point stepped in one fmi2DoStep, its statistics read from the FMU's stat_*
+outputs (exact at the impacts, no sampling) over the window from --t-from (0.2 s, as `make
+demo`) to the end of a 1 s run. Sine mode (excitation = 1), all other parameters at the FMU's
+start values (the paper's) unless --set NAME=VALUE, from the bench start (xi = G/2, xi' = 0).
 
-Threshold, per frequency, by a geometric scan of A_rms from 0.5 rad/s^2 upwards, refined by
-bisection (shorter runs: only the impact counters are read). A level is classed
-  none       no impact at all in the run,
-  transient  impacts in the start-up transient only (none in the last --threshold-window s),
+Threshold, per frequency: A_rms scanned geometrically from 0.5 rad/s^2 upwards (x1.08), then
+both edges refined by bisection to --threshold-tol; the scan's levels of all frequencies run as
+one study, each bisection round as another. A level is classed
+  none       no impact at all in the run (the impact counters from t = 0),
+  transient  impacts in the start-up transient only (none in the last --threshold-window s:
+             stat_impacts_* with stats_from = duration - window),
   sustained  impacts still in the last --threshold-window s (on one or both flanks).
 Two levels per frequency:
   A_first      the lowest level with any impact (the start-up transient reaches a flank),
   A_sustained  the onset of sustained rattle: every scanned level from there up to 1.5x it
                sustains. Below it, a few isolated levels may sustain too (coexisting states
                near the onset); they are listed in threshold.csv and marked on the plot.
+A level the FMU refuses is reported with the FMU's message and ends that bisection.
 
 Outputs (in --out, default target/rattle_map): rattle_map.csv, threshold.csv, summary.txt,
 map_impacts_per_period.png, map_mean_run.png, map_impact_speed.png, map_power.png,
 map_overview.png, threshold.png, collapse.png (the paper's section 9 claims: runs vs
-main-shaft displacement, impact strength vs acceleration level).
-
-Parameters other than the excitation can be changed with --set NAME=VALUE (e.g. --set G=80e-6
-for the backlash the paper measured); the default is the paper's parameters.
-
-If the FMU refuses a step (fmi2DoStep error; builds before commit a9af466 did so near grazing
-contacts: "edge crossings without progress in time"), the run is retried with a slightly
-different output interval and the retry is recorded in the CSVs; a point that still fails is
-reported, not guessed.
+main-shaft displacement, impact strength vs acceleration level); the runner's points in
+grid/ and threshold/ (Parquet and CSV; a rerun reuses them).
 """
 
 import argparse
 import csv
 import math
-import multiprocessing as mp
 import os
-import shutil
 import sys
 import time
 
@@ -52,244 +47,150 @@ from matplotlib.colors import BoundaryNorm, LogNorm  # noqa: E402
 from matplotlib.patches import Rectangle  # noqa: E402
 from matplotlib.ticker import FuncFormatter  # noqa: E402
 
-from demo import SCENES, dist_str, read_params  # noqa: E402  (reuse, no duplicate)
-from gearrattle import rattle_stats as rs  # noqa: E402
+from demo import SCENES, read_params  # noqa: E402  (reuse, no duplicate)
+from gearrattle.study import engine, spec  # noqa: E402
+from gearrattle.study.cli import prepare  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+COUNTS = ["impacts_Fplus", "impacts_Fminus"]  # cumulative from t = 0
+NEEDED = ["stat_impacts_Fplus", "stat_impacts_Fminus", "stat_runs_Fplus", "stat_runs_Fminus",
+          "stat_run_mean_Fplus", "stat_run_mean_Fminus", "stat_run_max_Fplus",
+          "stat_run_max_Fminus", "stat_v_mean_Fplus", "stat_v_mean_Fminus", "stat_v_max_Fplus",
+          "stat_v_max_Fminus", "stat_P_contact", "stat_P_lubricant", "stat_a_rms"]
 
-GRID_OUTPUTS = ["impacts_Fplus", "impacts_Fminus", "impact_speed", "E_contact", "E_lubricant",
-                "a_pitch_L", "omega_L", "contact"]
-COUNT_OUTPUTS = ["impacts_Fplus", "impacts_Fminus"]
-RETRY_FACTORS = (1.0, 0.8, 0.6, 0.45)  # output interval multipliers tried in turn
-
-# --------------------------------------------------------------------------- progress bar
-
-
-class Progress:
-    """A small progress bar on stderr: redrawn in place on a terminal, a line per 10 %
-    otherwise (make logs, CI)."""
-
-    def __init__(self, total, label, stream=sys.stderr, width=30):
-        self.total, self.label, self.stream, self.width = max(total, 1), label, stream, width
-        self.done, self.t0, self.last_decile = 0, time.perf_counter(), -1
-        self.tty = hasattr(stream, "isatty") and stream.isatty()
-        self._draw("")
-
-    def update(self, n=1, note=""):
-        self.done += n
-        self._draw(note)
-
-    def _draw(self, note):
-        frac = self.done / self.total
-        el = time.perf_counter() - self.t0
-        eta = el / frac * (1 - frac) if frac > 0 else float("nan")
-        fill = int(round(self.width * frac))
-        line = (f"{self.label} [{'#' * fill}{'.' * (self.width - fill)}] {self.done}/{self.total} "
-                f"{100 * frac:3.0f}%  {el:5.0f} s elapsed"
-                + (f", ~{eta:.0f} s left" if self.done and self.done < self.total else "")
-                + (f"  {note}" if note else ""))
-        if self.tty:
-            self.stream.write("\r" + line[:150].ljust(150))
-        else:
-            decile = int(10 * frac)
-            if decile == self.last_decile and self.done < self.total:
-                return
-            self.last_decile = decile
-            self.stream.write(line + "\n")
-        self.stream.flush()
-
-    def close(self):
-        if self.tty:
-            self.stream.write("\n")
-            self.stream.flush()
+# --------------------------------------------------------------------------- grid statistics
 
 
-# --------------------------------------------------------------------------- simulation (workers)
-
-_W = {}  # per worker process: the unzipped FMU and its model description
-
-
-def _init_worker(fmu_dir):
-    from fmpy import read_model_description
-
-    _W["dir"] = fmu_dir
-    _W["md"] = read_model_description(fmu_dir)
+def _weighted(a, wa, b, wb):
+    return (a * wa + b * wb) / (wa + wb) if wa + wb else float("nan")
 
 
-def simulate(f, A, duration, interval, outputs, overrides=None):
-    """One sine-mode run; retried with other output intervals if the FMU refuses a step.
-    overrides: other start values (parameters), {name: value}.
-
-    Returns (result or None, output interval used, retries, last FMU error message or '')."""
-    from fmpy import simulate_fmu
-
-    err = ""
-    for k, fac in enumerate(RETRY_FACTORS):
-        msgs = []
-
-        def logger(_env, _inst, status, category, message):
-            if status >= 3:  # error, fatal
-                msgs.append(message.decode(errors="replace") if isinstance(message, bytes)
-                            else str(message))
-
-        h = interval * fac
-        try:
-            res = simulate_fmu(
-                _W["dir"], model_description=_W["md"], fmi_type="CoSimulation",
-                start_time=0.0, stop_time=duration, output_interval=h,
-                start_values={**(overrides or {}), "excitation": 1, "f_exc": float(f),
-                              "A_rms": float(A)},
-                output=outputs, logger=logger,
-            )
-            return res, h, k, err
-        except Exception as e:  # noqa: BLE001 (an FMU error: retry, then report)
-            err = (msgs[-1] if msgs else f"{type(e).__name__}: {e}").replace("\n", " ")
-    return None, interval, len(RETRY_FACTORS), err
-
-
-def grid_point(task):
-    """Statistics of one (f, A_rms) grid point: a flat dict for the CSV."""
-    _, f, A, a = task
-    t0 = time.perf_counter()
-    out = {"f_Hz": f, "A_rms": A}
-    try:
-        res, h, retries, err = simulate(f, A, a["duration"], a["interval"], GRID_OUTPUTS,
-                                       a["set"])
-        out.update(output_interval=h, retries=retries, fmu_error=err)
-        if res is None:
-            out["status"] = "failed"
-        else:
-            t = res["time"]
-            st = rs.rattle_summary(
-                t, res["impacts_Fplus"], res["impacts_Fminus"], f, a["t_from"],
-                impact_speed=res["impact_speed"],
-                energies=(("contact", res["E_contact"]), ("lubricant", res["E_lubricant"])),
-                accel=res["a_pitch_L"])
-            st["power_dissipated"] = st["power_contact"] + st["power_lubricant"]
-            st["run_lengths"] = dist_str(st["run_lengths"])
-            dec = rs.free_flight_decay(t, res["omega_L"], res["contact"], a["t_from"])
-            st["free_flight_decay"] = float(np.median(dec)) if len(dec) else float("nan")
-            fl = rs.free_flights(t, res["contact"], a["t_from"])
-            st["free_flights"] = len(fl)
-            c = res["contact"]
-            for name, keep in (("free_flight_mean_duration", lambda a_, b_: True),
-                               ("crossing_flight_mean_duration", lambda a_, b_: a_ != b_),
-                               ("bounce_flight_mean_duration", lambda a_, b_: a_ == b_)):
-                d = [t[e] - t[s] for s, e in fl if keep(c[s - 1], c[e])]
-                st[name] = float(np.mean(d)) if d else float("nan")
-            out.update(st)
-            out["status"] = "ok" if st["ambiguous"] == 0 else "ambiguous"
-    except Exception as e:  # noqa: BLE001 (never let a worker die: report the point)
-        out.update(status="failed", fmu_error=f"{type(e).__name__}: {e}")
-    out["wall_s"] = time.perf_counter() - t0
-    return out
+def grid_rows(table, duration, t_from):
+    """One dict per grid point: the map's statistics from the FMU's stat_* outputs."""
+    rows = []
+    for r in table.to_pylist():
+        out = {"f_Hz": r["f_exc"], "A_rms": r["A_rms"], "cpu_s": r["cpu_s"],
+               "status": "ok" if r["status"] == "ok" else "failed", "fmu_error": r["message"]}
+        if r["status"] == "ok":
+            npl, nmi = r["stat_impacts_Fplus"], r["stat_impacts_Fminus"]
+            rpl, rmi = r["stat_runs_Fplus"], r["stat_runs_Fminus"]
+            periods = r["f_exc"] * (duration - t_from)
+            out.update(
+                periods=periods, impacts_Fplus=npl, impacts_Fminus=nmi,
+                impacts_per_period=(npl + nmi) / periods,
+                impacts_per_period_Fplus=npl / periods, impacts_per_period_Fminus=nmi / periods,
+                runs=rpl + rmi, mean_run_Fplus=r["stat_run_mean_Fplus"],
+                mean_run_Fminus=r["stat_run_mean_Fminus"],
+                mean_run=_weighted(r["stat_run_mean_Fplus"], rpl, r["stat_run_mean_Fminus"], rmi),
+                run_max=max(r["stat_run_max_Fplus"], r["stat_run_max_Fminus"]),
+                mean_impact_speed=_weighted(r["stat_v_mean_Fplus"], npl, r["stat_v_mean_Fminus"],
+                                            nmi),
+                mean_impact_speed_Fplus=r["stat_v_mean_Fplus"],
+                mean_impact_speed_Fminus=r["stat_v_mean_Fminus"],
+                max_impact_speed=max(r["stat_v_max_Fplus"], r["stat_v_max_Fminus"]),
+                power_contact=r["stat_P_contact"], power_lubricant=r["stat_P_lubricant"],
+                power_dissipated=r["stat_P_contact"] + r["stat_P_lubricant"],
+                rms_accel=r["stat_a_rms"])
+        rows.append(out)
+    return rows
 
 
-def classify(f, A, a):
-    """'none' / 'transient' / 'sustained' (see the module docstring), or None if the FMU
-    failed; with the impacts in the window on F+ and F-, the retries and the FMU error."""
-    D, win = a["thr_duration"], a["thr_window"]
-    res, _, retries, err = simulate(f, A, D, a["thr_interval"], COUNT_OUTPUTS, a["set"])
-    if res is None:
-        return None, 0, 0, retries, err
-    t, p, m = res["time"], res["impacts_Fplus"], res["impacts_Fminus"]
-    i = int(np.searchsorted(t, D - win - 1e-12))
-    lp, lm = int(p[-1] - p[i]), int(m[-1] - m[i])
-    if p[-1] + m[-1] == 0:
-        c = "none"
-    elif lp + lm == 0:
-        c = "transient"
-    else:
-        c = "sustained"
-    return c, lp, lm, retries, err
+# --------------------------------------------------------------------------- threshold
 
 
-def threshold(task):
-    """No-impact threshold at one frequency: geometric scan, then bisection of both edges."""
-    _, f, _, a = task
-    t0 = time.perf_counter()
-    scan = []  # (A, class, last-window impacts F+, F-)
-    stats = {"sims": 0, "retried": 0, "failed": 0, "errors": []}
-
-    def cls(A):
-        # a level whose run fails even after the retries is nudged by 0.1 %, not guessed
-        for nudge in (1.0, 1.001, 0.999, 1.002):
-            c, lp, lm, retries, err = classify(f, A * nudge, a)
-            stats["sims"] += retries + (c is not None)
-            stats["retried"] += retries > 0
-            if err:
-                stats["errors"].append(f"{A * nudge:.4g}: {err}")
-            if c is not None:
-                return c, lp, lm
-        stats["failed"] += 1
+def classify(r):
+    """'none' / 'transient' / 'sustained' of a threshold run (see the module docstring), with
+    the impacts in the window on F+ and F-; None if the FMU refused the level."""
+    if r["status"] != "ok":
         return None, 0, 0
+    lp, lm = r["stat_impacts_Fplus"], r["stat_impacts_Fminus"]
+    if r["impacts_Fplus"] + r["impacts_Fminus"] == 0:
+        return "none", lp, lm
+    return ("transient" if lp + lm == 0 else "sustained"), lp, lm
 
-    A, streak = a["thr_lo"], None
-    while A <= a["thr_hi"]:
-        c, lp, lm = cls(A)
+
+def _run_levels(study, model, data, session, points, name):
+    """Classes of the levels {(f, A)} run as one study in study.out/name."""
+    study.out = os.path.join(study.base, name)
+    table = engine.execute(study, model, data, points=[{"f_exc": f, "A_rms": A}
+                                                         for f, A in points], session=session)
+    res = {(r["f_exc"], r["A_rms"]): r for r in table.to_pylist()}
+    return {k: (classify(res[k]), res[k]["message"]) for k in points}
+
+
+def scan_one(f, levels, classes, meta):
+    """The scan at one frequency as rattle_map always read it: up to the level where sustained
+    rattle has held from its onset to thr_confirm times it. (scan, streak start or None)."""
+    scan, streak = [], None
+    for A in levels:
+        (c, lp, lm), _ = classes[(f, A)]
         scan.append((A, c, lp, lm))
         if c == "sustained":
             streak = A if streak is None else streak
-            if A >= a["thr_confirm"] * streak:
+            if A >= meta["thr_confirm"] * streak:
                 break
         elif c is not None:
             streak = None
-        A *= a["thr_ratio"]
-    levels = [s[0] for s in scan]
-    classes = [s[1] for s in scan]
-    out = {"f_Hz": f, "scan": scan}
+    return scan, streak
 
-    def bisect(lo, hi, is_hi):
-        while hi / lo > 1 + a["thr_tol"]:
-            mid = math.sqrt(lo * hi)
-            c, _, _ = cls(mid)
+
+def thresholds(study, model, data, session, fs, meta):
+    """A_first and A_sustained at each frequency (geometric scan, then rounds of bisection)."""
+    levels, A = [], meta["thr_lo"]
+    while A <= meta["thr_hi"]:
+        levels.append(A)
+        A *= meta["thr_ratio"]
+    classes = _run_levels(study, model, data, session, [(f, A) for f in fs for A in levels],
+                          "scan")
+    out, brackets = {}, {}
+    for f in fs:
+        scan, streak = scan_one(f, levels, classes, meta)
+        lv = [s[0] for s in scan]
+        cl = [s[1] for s in scan]
+        t = out[f] = {"f_Hz": f, "scan": scan, "errors": [f"{A:.4g}: {classes[(f, A)][1]}"
+                                                          for A in lv if classes[(f, A)][0][0]
+                                                          is None]}
+        first = next((i for i, c in enumerate(cl) if c not in ("none", None)), None)
+        t["A_first"] = t["A_first_lo"] = float("nan")
+        if first:
+            brackets[(f, "first")] = [lv[first - 1], lv[first]]
+        t["A_sustained"] = t["A_sustained_lo"] = float("nan")
+        t["isolated_sustained"] = []
+        if streak is not None and lv[-1] >= meta["thr_confirm"] * streak:
+            j = lv.index(streak)
+            t["A_sustained"] = streak
+            if j:
+                brackets[(f, "sustained")] = [lv[j - 1], streak]
+            t["isolated_sustained"] = [s[0] for s in scan[:j] if s[1] == "sustained"]
+        t["one_sided"] = [(s[0], "F+" if s[3] == 0 else "F-") for s in scan
+                          if s[1] == "sustained" and (s[2] == 0 or s[3] == 0)]
+        t["sims"] = len(lv)
+    active, rnd = dict(brackets), 0
+    while active:
+        rnd += 1
+        mids = {k: math.sqrt(lo * hi) for k, (lo, hi) in active.items()}
+        res = _run_levels(study, model, data, session, sorted({(f, A) for (f, _), A in
+                                                               mids.items()}), f"bisection{rnd}")
+        for (f, edge), mid in mids.items():
+            (c, _, _), msg = res[(f, mid)]
+            out[f]["sims"] += 1
             if c is None:
-                break
-            if is_hi(c):
-                hi = mid
-            else:
-                lo = mid
-        return lo, hi
+                out[f]["errors"].append(f"{mid:.4g}: {msg}")
+                del active[(f, edge)]
+                continue
+            lo_hi = active[(f, edge)]
+            lo_hi[1 if (c != "none" if edge == "first" else c == "sustained") else 0] = mid
+            if lo_hi[1] / lo_hi[0] <= 1 + meta["thr_tol"]:
+                del active[(f, edge)]
+    for (f, edge), (lo, hi) in brackets.items():
+        out[f][f"A_{edge}_lo"], out[f][f"A_{edge}"] = lo, hi
+    return [out[f] for f in fs]
 
-    # A_first: lowest level with any impact
-    first = next((i for i, c in enumerate(classes) if c not in ("none", None)), None)
-    if first is None or first == 0:
-        out["A_first"], out["A_first_lo"] = float("nan"), float("nan")
-    else:
-        lo, hi = bisect(levels[first - 1], levels[first], lambda c: c != "none")
-        out["A_first_lo"], out["A_first"] = lo, hi
-    # A_sustained: start of the final sustained streak
-    if streak is None or levels[-1] < a["thr_confirm"] * streak:
-        out["A_sustained"], out["A_sustained_lo"] = float("nan"), float("nan")
-        below = []
-    else:
-        j = levels.index(streak)
-        lo, hi = bisect(levels[j - 1], streak, lambda c: c == "sustained") if j else (
-            float("nan"), streak)
-        out["A_sustained_lo"], out["A_sustained"] = lo, hi
-        below = [s for s in scan[:j] if s[1] == "sustained"]
-    out["isolated_sustained"] = [s[0] for s in below]
-    out["one_sided"] = [(s[0], "F+" if s[3] == 0 else "F-") for s in scan
-                        if s[1] == "sustained" and (s[2] == 0 or s[3] == 0)]
-    out.update(sims=stats["sims"], retried=stats["retried"], failed=stats["failed"],
-               fmu_errors=stats["errors"], wall_s=time.perf_counter() - t0)
-    return out
-
-
-def run_task(task):
-    try:
-        return task[0], (grid_point(task) if task[0] == "grid" else threshold(task))
-    except Exception as e:  # noqa: BLE001
-        return task[0], {"f_Hz": task[1], "A_rms": task[2], "status": "failed",
-                         "fmu_error": f"{type(e).__name__}: {e}"}
-
-
-# --------------------------------------------------------------------------- figures
 
 def grid_array(rows, fs, As, key, scale=1.0):
     Z = np.full((len(As), len(fs)), np.nan)
     for r in rows:
-        if r.get("status") in ("ok", "ambiguous") and key in r:
+        if r["status"] == "ok":
             i = As.index(r["A_rms"])
             j = fs.index(r["f_Hz"])
             Z[i, j] = r[key] * scale
@@ -481,7 +382,7 @@ def spearman(x, y):
 
 
 def collapse_data(rows, p):
-    ok = [r for r in rows if r.get("status") in ("ok", "ambiguous")]
+    ok = [r for r in rows if r["status"] == "ok"]
     f = np.array([r["f_Hz"] for r in ok], dtype=float)
     A = np.array([r["A_rms"] for r in ok], dtype=float)
     disp = 1e6 * p["r_M"] * np.sqrt(2) * A / (2 * np.pi * f) ** 2  # µm on the pitch circle
@@ -525,12 +426,10 @@ def collapse_figure(rows, p, out):
 CSV_COLS = [
     "f_Hz", "A_rms", "status", "periods", "impacts_Fplus", "impacts_Fminus",
     "impacts_per_period", "impacts_per_period_Fplus", "impacts_per_period_Fminus",
-    "runs", "mean_run", "mean_run_Fplus", "mean_run_Fminus", "run_min", "run_max", "run_lengths",
+    "runs", "mean_run", "mean_run_Fplus", "mean_run_Fminus", "run_max",
     "mean_impact_speed", "mean_impact_speed_Fplus", "mean_impact_speed_Fminus",
-    "max_impact_speed", "runs_decreasing", "min_gap_same_flank", "power_dissipated", "power_contact",
-    "power_lubricant", "rms_accel", "free_flight_decay", "free_flights",
-    "free_flight_mean_duration", "crossing_flight_mean_duration", "bounce_flight_mean_duration",
-    "ambiguous", "output_interval", "retries", "wall_s", "fmu_error",
+    "max_impact_speed", "power_dissipated", "power_contact", "power_lubricant", "rms_accel",
+    "cpu_s", "fmu_error",
 ]
 
 
@@ -551,8 +450,7 @@ def write_grid_csv(rows, path):
 
 def write_threshold_csv(thr, path):
     cols = ["f_Hz", "A_first_lo", "A_first", "A_sustained_lo", "A_sustained",
-            "isolated_sustained", "one_sided", "scan", "sims", "retried", "failed", "wall_s",
-            "fmu_errors"]
+            "isolated_sustained", "one_sided", "scan", "sims", "fmu_errors"]
     code = {"none": ".", "transient": "t", "sustained": "S", None: "E"}
     with open(path, "w", newline="") as fh:
         w = csv.writer(fh)
@@ -563,26 +461,22 @@ def write_threshold_csv(thr, path):
             row["one_sided"] = " ".join(f"{A:.3g}({fl})" for A, fl in t["one_sided"])
             # the scan as level:class, class . none, t transient, S sustained, E FMU failure
             row["scan"] = " ".join(f"{A:.3g}:{code[c]}" for A, c, _, _ in t["scan"])
-            row["fmu_errors"] = " | ".join(t.get("fmu_errors", []))
+            row["fmu_errors"] = " | ".join(t["errors"])
             w.writerow([fmt_cell(row.get(c, "")) for c in cols])
     return path
 
 
 def summary_lines(rows, thr, fs, As, p, meta):
     L = []
-    rows = sorted(rows, key=lambda r: (r["f_Hz"], r["A_rms"]))
-    ok = [r for r in rows if r.get("status") in ("ok", "ambiguous")]
-    bad = [r for r in rows if r.get("status") == "failed"]
-    amb = [r for r in rows if r.get("status") == "ambiguous"]
-    retried = [r for r in rows if r.get("retries", 0)]
+    ok = [r for r in rows if r["status"] == "ok"]
+    bad = [r for r in rows if r["status"] != "ok"]
     L.append(f"Grid: f = {fs[0]:g}..{fs[-1]:g} Hz ({len(fs)} values) x A_rms = {As[0]:g}.."
              f"{As[-1]:g} rad/s^2 RMS ({len(As)} values): {len(rows)} points, {len(ok)} ok, "
-             f"{len(bad)} failed, {len(retried)} retried after an FMU step failure, "
-             f"{len(amb)} with ambiguous impact order (output interval too coarse)")
-    L.append(f"  {param_note(p, meta)}; runs of {meta['duration']:g} s, statistics {meta['t_from']:g}-"
-             f"{meta['duration']:g} s, output interval {meta['interval']:g} s")
+             f"{len(bad)} refused by the FMU")
+    L.append(f"  {param_note(p, meta)}; runs of {meta['duration']:g} s, statistics "
+             f"{meta['t_from']:g}-{meta['duration']:g} s (the FMU's stat_* outputs)")
     for r in bad:
-        L.append(f"  FAILED f={r['f_Hz']:g} A={r['A_rms']:g}: {r.get('fmu_error', '')}")
+        L.append(f"  REFUSED f={r['f_Hz']:g} A={r['A_rms']:g}: {r['fmu_error']}")
     if not ok:
         return L
     f, A, disp, run, v, arms = collapse_data(rows, p)
@@ -593,120 +487,34 @@ def summary_lines(rows, thr, fs, As, p, meta):
     ipp = np.array([r["impacts_per_period"] for r in ok])
     pw = np.array([r["power_dissipated"] for r in ok])
     pc = np.array([r["power_contact"] for r in ok])
-    dec = np.array([r["free_flight_decay"] for r in ok])
-    gap = np.array([r["min_gap_same_flank"] for r in ok])
     asym = np.array([abs(r["impacts_Fplus"] - r["impacts_Fminus"]) /
                      max(r["impacts_Fplus"] + r["impacts_Fminus"], 1) for r in ok])
     L.append("Over the grid (min..max):")
     L.append(f"  impacts per period (F+ + F-): {rng(ipp)}")
-    L.append(f"  mean run on one flank:        {rng(run)}; every complete run on the grid has "
-             f"length {int(np.nanmin([r['run_min'] for r in ok]))}.."
-             f"{int(np.nanmax([r['run_max'] for r in ok]))}")
-    short = [f"{r['f_Hz']:g}/{r['A_rms']:g}" for r in ok if r["mean_run"] < 2]
-    L.append(f"  mean run < 2 at {len(short)} of {len(ok)} points (f Hz/A_rms): "
-             + (" ".join(short) or "-"))
+    L.append(f"  mean run on one flank:        {rng(run)}; longest run "
+             f"{int(max(r['run_max'] for r in ok))}")
     L.append(f"  mean impact speed:            {rng(v, fmt='{:.1f}')} mm/s")
     L.append(f"  dissipated power:             {rng(pw, 1e3, '{:.0f}')} mW, of which contact "
              f"{rng(pc / pw, 100, '{:.1f}')} % ({rng(pc, 1e3, '{:.1f}')} mW)")
     L.append(f"  RMS pitch-line acceleration:  {rng(arms, fmt='{:.1f}')} m/s^2")
     L.append(f"  |F+ - F-| / (F+ + F-) impacts: at most {100 * np.max(asym):.1f} %; above 5 % in "
-             f"{np.count_nonzero(asym > 0.05)} of {len(ok)} points (more on F+ in "
-             f"{sum(1 for r, a_ in zip(ok, asym) if a_ > 0.05 and r['impacts_Fplus'] > r['impacts_Fminus'])}"
-             f", on F- in "
-             f"{sum(1 for r, a_ in zip(ok, asym) if a_ > 0.05 and r['impacts_Fplus'] < r['impacts_Fminus'])})")
-    vp = np.array([r["mean_impact_speed_Fplus"] for r in ok])
-    vm = np.array([r["mean_impact_speed_Fminus"] for r in ok])
-    dv = (vp - vm) / (0.5 * (vp + vm))
-    L.append(f"  mean impact speed F+ vs F-: differ by more than 5 % in "
-             f"{np.count_nonzero(np.abs(dv) > 0.05)} of {len(ok)} points (faster on F+ in "
-             f"{np.count_nonzero(dv > 0.05)}, on F- in {np.count_nonzero(dv < -0.05)}); at most "
-             f"{100 * np.nanmax(np.abs(dv)):.0f} %")
-    dur = np.array([r["free_flight_mean_duration"] for r in ok])
-    rd = np.array([r["runs_decreasing"] for r in ok])
-    L.append(f"  runs of >= 2 impacts whose impact speeds decrease along the run: "
-             f"{rng(rd, 100, '{:.0f}')} % of the runs of a point; 100 % at "
-             f"{np.count_nonzero(rd == 1)} of {np.count_nonzero(np.isfinite(rd))} points")
-    L.append(f"  mean free-flight duration: {rng(dur, 1e3)} ms, i.e. the speed decays by "
-             f"{100 * (1 - np.exp(-p['C'] / p['I_L'] * np.nanmin(dur))):.0f}.."
-             f"{100 * (1 - np.exp(-p['C'] / p['I_L'] * np.nanmax(dur))):.0f} % over a mean flight")
-    L.append(f"  shortest time between two impacts on one flank: {1e3 * np.nanmin(gap):.2f} ms "
-             f"(output interval {1e3 * meta['interval']:.3f} ms)")
-    L.append(f"  free-flight speed decay rate (median per point): {rng(dec, fmt='{:.2f}')} 1/s "
-             f"(C* = C/I_L = {p['C'] / p['I_L']:.2f} 1/s)")
-    # where runs are long / short
-    L.append("Mean run on one flank by frequency (min..max over A_rms), grid cells with mean "
-             "run >= 3.5 / < 3.5:")
-    for fv in fs:
-        rr = np.array([r["mean_run"] for r in ok if r["f_Hz"] == fv])
-        long_ = [r["A_rms"] for r in ok if r["f_Hz"] == fv and r["mean_run"] >= 3.5]
-        L.append(f"  {fv:4g} Hz: {rng(rr)}   >= 3.5 at A_rms = "
-                 + (", ".join(f"{x:g}" for x in long_) if long_ else "-"))
-    L.append("Mean run on one flank against the main-shaft displacement amplitude on its pitch "
-             "circle, r_M sqrt(2) A_rms / (2 pi f)^2 (bins; mean, min..max over the cells):")
-    bins = [0, 50, 100, 150, 200, 250, 300, 400, 500, 1000]
-    for b0, b1 in zip(bins[:-1], bins[1:]):
-        sel = (disp >= b0) & (disp < b1)
-        if np.any(sel):
-            lo_f, hi_f = np.argmin(np.where(sel, f, np.inf)), np.argmax(np.where(sel, f, -np.inf))
-            L.append(f"  {b0:4d}-{b1:<4d} um: {np.nanmean(run[sel]):.2f} ({rng(run[sel])}, "
-                     f"{np.count_nonzero(sel):2d} cells); RMS accel {arms[lo_f]:.1f} m/s^2 at "
-                     f"{f[lo_f]:g} Hz, {arms[hi_f]:.1f} at {f[hi_f]:g} Hz")
-    parts = []
-    for Av in As:
-        x = arms[A == Av]
-        if len(x):
-            parts.append(f"{Av:g}: {rng(x, fmt='{:.1f}')}")
-    L.append("RMS pitch-line acceleration [m/s^2] over f at fixed A_rms (min..max): "
-             + "; ".join(parts))
+             f"{np.count_nonzero(asym > 0.05)} of {len(ok)} points")
     L.append("Paper section 9 (Spearman rank correlation over the grid):")
     L.append(f"  mean run vs main-shaft displacement amplitude {spearman(disp, run):+.2f}, "
              f"vs A_rms {spearman(A, run):+.2f}")
     L.append(f"  RMS acceleration vs A_rms {spearman(A, arms):+.2f}, vs displacement "
              f"{spearman(disp, arms):+.2f}; mean impact speed vs A_rms {spearman(A, v):+.2f}, "
              f"vs displacement {spearman(disp, v):+.2f}")
-    # Along the level at fixed frequency: more impacts? stronger?
-    L.append("Raising the level at fixed f (first -> last A_rms of the grid):")
-    for fv in sorted({fs[0], fs[len(fs) // 2], fs[-1]}):
-        col = sorted((r for r in ok if r["f_Hz"] == fv), key=lambda r: r["A_rms"])
-        if len(col) >= 2:
-            a0, a1 = col[0], col[-1]
-            L.append(f"  {fv:g} Hz, {a0['A_rms']:g} -> {a1['A_rms']:g}: impacts/period "
-                     f"{a0['impacts_per_period']:.2f} -> {a1['impacts_per_period']:.2f}, mean run "
-                     f"{a0['mean_run']:.2f} -> {a1['mean_run']:.2f}, impact speed "
-                     f"{1e3 * a0['mean_impact_speed']:.1f} -> {1e3 * a1['mean_impact_speed']:.1f}"
-                     f" mm/s, RMS accel {a0['rms_accel']:.1f} -> {a1['rms_accel']:.1f} m/s^2")
-    lv = [s["A_rms"] for s in SCENES if s["name"] in ("S1", "S3")]
-    if len(lv) == 2 and all(x in As for x in lv):
-        lo_, hi_ = lv
-        cmp_ = []
-        for fv in fs:
-            r0 = next((r for r in ok if r["f_Hz"] == fv and r["A_rms"] == lo_), None)
-            r1 = next((r for r in ok if r["f_Hz"] == fv and r["A_rms"] == hi_), None)
-            if r0 and r1:
-                cmp_.append((fv, r0, r1))
-        fewer = [fv for fv, r0, r1 in cmp_ if r1["impacts_per_period"] < r0["impacts_per_period"]]
-        same = [fv for fv, r0, r1 in cmp_ if r1["impacts_per_period"] == r0["impacts_per_period"]]
-        faster = [fv for fv, r0, r1 in cmp_ if r1["mean_impact_speed"] > r0["mean_impact_speed"]]
-        harder = [fv for fv, r0, r1 in cmp_ if r1["rms_accel"] > r0["rms_accel"]]
-        L.append(f"S1 -> S3 level ({lo_:g} -> {hi_:g} rad/s^2) at each of {len(cmp_)} frequencies: "
-                 f"more impacts per period at {len(cmp_) - len(fewer) - len(same)}, as many at "
-                 f"{len(same)}, fewer at {len(fewer)} ({', '.join(f'{x:g}' for x in fewer) or '-'}"
-                 f" Hz); higher mean impact speed at {len(faster)}, higher RMS acceleration at "
-                 f"{len(harder)}")
     L.append("Bench scenes (cells of this map; cf. `make demo` and MODEL.md section 5):")
+    span = meta["duration"] - meta["t_from"]
     for s in SCENES:
         r = next((r for r in ok if r["f_Hz"] == s["f"] and r["A_rms"] == s["A_rms"]), None)
         if r is None:
             continue
-        span = meta["duration"] - meta["t_from"]
         L.append(f"  {s['name']} ({s['f']:g} Hz, {s['A_rms']:g}): impacts/s F+/F- "
-                 f"{r['impacts_Fplus'] / span:.1f}/{r['impacts_Fminus'] / span:.1f}, runs "
-                 f"{r['run_lengths']}, mean impact speed {1e3 * r['mean_impact_speed']:.1f} mm/s,"
-                 f" RMS accel {r['rms_accel']:.1f} m/s^2, mean free flight "
-                 f"{1e3 * r['free_flight_mean_duration']:.2f} ms (across the gap "
-                 f"{1e3 * r['crossing_flight_mean_duration']:.2f}, bounces on one flank "
-                 f"{1e3 * r['bounce_flight_mean_duration']:.2f}), impact speeds decreasing "
-                 f"along {100 * r['runs_decreasing']:.0f} % of the runs")
+                 f"{r['impacts_Fplus'] / span:.1f}/{r['impacts_Fminus'] / span:.1f}, mean run "
+                 f"{r['mean_run']:.2f} (longest {r['run_max']}), mean impact speed "
+                 f"{1e3 * r['mean_impact_speed']:.1f} mm/s, RMS accel {r['rms_accel']:.1f} m/s^2")
         if not meta["set"]:  # the references hold for the paper's parameters only
             L.append(f"      model reference: {s['model_ref']}")
         L.append(f"      paper (measured): {s['paper']}")
@@ -714,29 +522,21 @@ def summary_lines(rows, thr, fs, As, p, meta):
         L.append("No-impact threshold (A_rms in rad/s^2 RMS; [lo, hi] brackets of the bisection):")
         L.append(f"  {'f Hz':>5}  {'A_first':>16}  {'A_sustained':>16}  isolated sustaining "
                  f"levels below the onset; one-sided sustained levels")
-        for t in sorted(thr, key=lambda t: t["f_Hz"]):
+        for t in thr:
             iso = ", ".join(f"{x:.3g}" for x in t["isolated_sustained"]) or "-"
             one = ", ".join(f"{x:.3g} ({fl} only)" for x, fl in t["one_sided"]) or "-"
             L.append(f"  {t['f_Hz']:5g}  {t['A_first']:6.3g} [{t['A_first_lo']:.3g},"
                      f"{t['A_first']:.3g}]  {t['A_sustained']:6.3g} [{t['A_sustained_lo']:.3g},"
                      f"{t['A_sustained']:.3g}]  {iso}; {one}")
-        fails = sum(t.get("failed", 0) for t in thr)
-        retr = sum(t.get("retried", 0) for t in thr)
-        sims = sum(t.get("sims", 0) for t in thr)
-        L.append(f"  {sims} threshold runs; {retr} levels needed a retry after an FMU step "
-                 f"failure (see threshold.csv, fmu_errors); {fails} levels failed at every "
-                 f"output interval and 0.1 % nudge (left out of the search)")
+        errs = sum(len(t["errors"]) for t in thr)
+        L.append(f"  {sum(t['sims'] for t in thr)} threshold runs; {errs} levels refused by the "
+                 f"FMU (threshold.csv, fmu_errors)")
         f_thr = np.array([t["f_Hz"] for t in thr])
-        a2 = np.array([t["A_sustained"] for t in thr])
         for key, name in (("A_first", "first impact"), ("A_sustained", "sustained rattle")):
             fit = power_fit(f_thr, np.array([t[key] for t in thr]))
             if fit:
                 L.append(f"  fit of the {name} (least squares of ln A on ln f): "
                          f"{fit[0]:.2f} (f/30 Hz)^{fit[1]:.2f}")
-        if np.any(np.isfinite(a2)):
-            L.append(f"  highest onset of sustained rattle: {np.nanmax(a2):.3g} rad/s^2, "
-                     f"{As[0] / np.nanmax(a2):.1f}x below the lowest level of the grid "
-                     f"({As[0]:g})")
     return L
 
 
@@ -747,89 +547,77 @@ def frange(lo, hi, step):
     return [round(lo + i * step, 10) for i in range(n + 1)]
 
 
+def axis(name, text, flag):
+    """An axis of the map from lo:hi:step."""
+    try:
+        lo, hi, step = map(float, text.split(":"))
+    except ValueError:
+        raise spec.StudyError(f"{flag} {text}: give lo:hi:step") from None
+    if not (step > 0 and hi >= lo):
+        raise spec.StudyError(f"{flag} {text}: give lo <= hi and step > 0")
+    vals = frange(lo, hi, step)
+    return spec.Axis(name, vals[0], vals[-1], len(vals), f"{flag} {text}")
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--fmu", default=os.path.join(ROOT, "target", "fmu", "GearRattle.fmu"))
     ap.add_argument("--out", default=os.path.join(ROOT, "target", "rattle_map"))
-    ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--workers", type=int, default=None,
+                    help="Dask worker processes (default: one per core; 0: serial)")
+    ap.add_argument("--scheduler", default=None, help="an existing Dask cluster's address")
     ap.add_argument("--f", default="30:60:2", help="frequencies lo:hi:step [Hz]")
     ap.add_argument("--A", default="100:700:50", help="levels lo:hi:step [rad/s^2 RMS]")
     ap.add_argument("--duration", type=float, default=1.0, help="simulated time per point [s]")
     ap.add_argument("--t-from", type=float, default=0.2, help="statistics from here [s]")
-    ap.add_argument("--interval", type=float, default=5e-5,
-                    help="output interval of the grid runs [s] (impacts are read from the "
-                         "counters: at most one impact per interval)")
     ap.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
                     help="override a parameter's start value (repeatable), e.g. --set G=80e-6; "
                          "the default is the paper's parameters")
     ap.add_argument("--no-threshold", action="store_true", help="skip the threshold search")
     ap.add_argument("--threshold-duration", type=float, default=1.0)
     ap.add_argument("--threshold-window", type=float, default=0.4)
-    ap.add_argument("--threshold-interval", type=float, default=1e-3)
     ap.add_argument("--threshold-tol", type=float, default=0.005,
                     help="relative width of the bisection's final bracket")
     args = ap.parse_args(argv)
-
-    if not os.path.isfile(args.fmu):
-        print(f"rattle_map: no FMU at {args.fmu}: build it first (make fmu)", file=sys.stderr)
-        return 2
-    if not 0 <= args.t_from < args.duration:
-        ap.error("need 0 <= --t-from < --duration")
     if not 0 < args.threshold_window < args.threshold_duration:
         ap.error("need 0 < --threshold-window < --threshold-duration")
-    overrides = {}
-    for item in args.set:
-        name, _, val = item.partition("=")
-        try:
-            overrides[name.strip()] = float(val)
-        except ValueError:
-            ap.error(f"--set {item}: expected NAME=number")
-    fs = frange(*map(float, args.f.split(":")))
-    As = frange(*map(float, args.A.split(":")))
-    os.makedirs(args.out, exist_ok=True)
-    meta = dict(duration=args.duration, t_from=args.t_from, interval=args.interval,
-                thr_duration=args.threshold_duration, thr_window=args.threshold_window,
-                thr_interval=args.threshold_interval, thr_tol=args.threshold_tol,
-                thr_lo=0.5, thr_hi=As[0], thr_ratio=1.08, thr_confirm=1.5, set=overrides)
-
-    from fmpy import extract
-
     t_all = time.perf_counter()
-    fmu_dir = extract(args.fmu)
+    grid = spec.Study(kind="map", fmu=args.fmu, out=os.path.join(args.out, "grid"),
+                      duration=args.duration, stats_from=(args.t_from, f"--t-from {args.t_from:g}"),
+                      workers=args.workers, scheduler=args.scheduler)
     try:
-        md, p = read_params(fmu_dir)
-        params = {v.name for v in md.modelVariables if v.causality == "parameter"}
-        bad = sorted(set(overrides) - params) + sorted(
-            {"excitation", "f_exc", "A_rms"} & set(overrides))
-        if bad:
-            ap.error(f"--set: not a settable parameter here: {', '.join(bad)} (parameters: "
-                     f"{', '.join(sorted(params - {'excitation', 'f_exc', 'A_rms'}))})")
-        p.update(overrides)
-        tasks = [] if args.no_threshold else [("thr", f, None, meta) for f in fs]
-        tasks += [("grid", f, A, meta) for f in fs for A in As]
-        print(f"rattle map: {args.fmu}; {len(fs)} x {len(As)} grid points"
-              + ("" if args.no_threshold else f" + threshold search at {len(fs)} frequencies")
-              + f" on {args.workers} workers", file=sys.stderr)
-        rows, thr = [], []
-        bar = Progress(len(tasks), "rattle map")
-        with mp.get_context("fork").Pool(args.workers, initializer=_init_worker,
-                                         initargs=(fmu_dir,)) as pool:
-            for kind, r in pool.imap_unordered(run_task, tasks):
-                if kind == "grid":
-                    rows.append(r)
-                    note = f"{r['f_Hz']:g} Hz {r['A_rms']:g}: {r.get('status')}"
-                else:
-                    thr.append(r)
-                    note = f"threshold {r['f_Hz']:g} Hz: {r.get('A_sustained', float('nan')):.3g}"
-                bar.update(1, note)
-        bar.close()
-        wall_sim = time.perf_counter() - t_all
-    finally:
-        shutil.rmtree(fmu_dir, ignore_errors=True)
-
-    thr_failed = [t for t in thr if "scan" not in t]
-    thr = sorted((t for t in thr if "scan" in t), key=lambda t: t["f_Hz"])
-    rows.sort(key=lambda r: (r["f_Hz"], r["A_rms"]))
+        grid.axes = [axis("f_exc", args.f, "--f"), axis("A_rms", args.A, "--A")]
+        for text in args.set:
+            name, value = spec.parse_set(text, f"--set {text}")
+            grid.fixed[name] = (value, f"--set {text}")
+        model, data = prepare(grid)
+        missing = [m for m in NEEDED if m not in {v.name for v in model.metrics}]
+        if missing:
+            raise spec.StudyError(f"{args.fmu} lacks the outputs {', '.join(missing)}: rebuild "
+                                  f"it (make fmu)")
+    except spec.StudyError as e:
+        print(f"rattle_map: {e}", file=sys.stderr)
+        return 2
+    fs, As = grid.axes[0].values(), grid.axes[1].values()
+    overrides = {k: v for k, (v, w) in grid.fixed.items() if w != "default"}
+    meta = dict(duration=args.duration, t_from=args.t_from, thr_duration=args.threshold_duration,
+                thr_window=args.threshold_window, thr_tol=args.threshold_tol, thr_lo=0.5,
+                thr_hi=As[0], thr_ratio=1.08, thr_confirm=1.5, set=overrides)
+    _, p = read_params(args.fmu)
+    p.update(overrides)
+    thr = []
+    with engine.Session(grid, model, data) as session:
+        table = engine.execute(grid, model, data, session=session)
+        if not args.no_threshold:
+            win = args.threshold_duration - args.threshold_window
+            tst = spec.Study(kind="map", fmu=args.fmu, out="", fixed=grid.fixed,
+                             duration=args.threshold_duration,
+                             stats_from=(win, "threshold window"), record=COUNTS)
+            tst.base = os.path.join(args.out, "threshold")
+            thr = thresholds(tst, model, data, session, fs, meta)
+    wall = time.perf_counter() - t_all
+    rows = grid_rows(table, args.duration, args.t_from)
+    os.makedirs(args.out, exist_ok=True)
     files = [write_grid_csv(rows, os.path.join(args.out, "rattle_map.csv"))]
     if thr:
         files.append(write_threshold_csv(thr, os.path.join(args.out, "threshold.csv")))
@@ -838,10 +626,9 @@ def main(argv=None):
         files.append(threshold_figure(thr, args.out, meta, (As[0], As[-1]), p))
     files.append(collapse_figure(rows, p, args.out))
     lines = summary_lines(rows, thr, fs, As, p, meta)
-    for t in thr_failed:
-        lines.append(f"THRESHOLD SEARCH FAILED at {t['f_Hz']:g} Hz: {t.get('fmu_error', '')}")
-    lines.append(f"wall time: {time.perf_counter() - t_all:.1f} s (simulations "
-                 f"{wall_sim:.1f} s on {args.workers} workers)")
+    cpu = [r["cpu_s"] for r in rows if r["cpu_s"] == r["cpu_s"]]
+    lines.append(f"wall time: {time.perf_counter() - t_all:.1f} s (simulations {wall:.1f} s; "
+                 f"CPU per grid point median {1e3 * float(np.median(cpu)):.2f} ms)")
     path = os.path.join(args.out, "summary.txt")
     with open(path, "w") as fh:
         fh.write("\n".join(lines) + "\n")
@@ -850,8 +637,7 @@ def main(argv=None):
     print("files:")
     for f in files:
         print("  " + os.path.relpath(f))
-    failed = [r for r in rows if r.get("status") == "failed"]
-    return 1 if failed or thr_failed else 0
+    return 1 if any(r["status"] != "ok" for r in rows) else 0
 
 
 if __name__ == "__main__":

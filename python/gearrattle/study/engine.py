@@ -3,6 +3,7 @@ single-threaded worker process per core, or the cluster at --scheduler), or seri
 process (workers = 0). Completed batches are stored as they arrive; points already stored are
 skipped."""
 
+import hashlib
 import logging
 import math
 import os
@@ -19,12 +20,12 @@ BATCH_MAX = 100  # points per batch at most (about 0.3 s of work on one core)
 class Plan:
     """The study's points with their full start values, identities and the result columns."""
 
-    def __init__(self, st, model):
+    def __init__(self, st, model, varied=None):
         self.st, self.model = st, model
         fixed = {n: v for n, (v, _) in st.fixed.items()}
         if st.stats_from is not None:
             fixed[STATS_FROM] = st.stats_from[0]
-        varied = designs.points(st)
+        varied = designs.points(st) if varied is None else varied
         self.values = [{**p, **fixed} for p in varied]
         names = list(varied[0]) if varied else []
         self.param_names = names + [n for n in fixed if n not in names]
@@ -41,9 +42,11 @@ def batch_size(n_points, n_workers):
     return max(1, min(BATCH_MAX, math.ceil(n_points / (TASKS_PER_WORKER * max(n_workers, 1)))))
 
 
-def execute(st, model, fmu_bytes, quiet=False):
-    """Run what is missing of the study; return the consolidated pyarrow table."""
-    plan = Plan(st, model)
+def execute(st, model, fmu_bytes, quiet=False, points=None, session=None):
+    """Run what is missing of the study; return the consolidated pyarrow table. points: the
+    varied values of each point, instead of the study's design; session: an open Session
+    (several studies on one cluster), else one is opened for this study."""
+    plan = Plan(st, model, points)
     store = results.Store(st.out)
     done = store.done()
     todo, seen = [], set()
@@ -66,8 +69,11 @@ def execute(st, model, fmu_bytes, quiet=False):
                 refused = sum(r["status"] != "ok" for r in full)
                 bar.update(len(full), f"{refused} refused" if refused else "")
 
-        run = _run_serial if st.workers == 0 else _run_dask
-        run(st, model, fmu_bytes, todo, store_batch)
+        if session is None:
+            with Session(st, model, fmu_bytes) as own:
+                own.run(st, todo, store_batch)
+        else:
+            session.run(st, todo, store_batch)
         if bar:
             bar.close()
     rows = [dict(done.get(pid) or computed[pid]) for pid in plan.ids]
@@ -76,41 +82,66 @@ def execute(st, model, fmu_bytes, quiet=False):
     return store.consolidate(rows, plan.schema)
 
 
+def _key(batch):
+    return "gearrattle-batch-" + hashlib.sha256("".join(p for _, p, _ in batch).encode()
+                                                ).hexdigest()[:24]
+
+
 def _batches(todo, size):
     return [todo[k:k + size] for k in range(0, len(todo), size)]
 
 
-def _run_serial(st, model, fmu_bytes, todo, store_batch):
-    install_fmu(model.guid, fmu_bytes)
-    for batch in _batches(todo, batch_size(len(todo), 1)):
-        store_batch(run_batch(model.guid, st.duration, tuple(st.record), batch))
+class Session:
+    """Where the points run: this process (workers = 0), a LocalCluster with one
+    single-threaded worker process per core (or --workers), or the cluster at --scheduler.
+    The FMU is installed on every worker by a plugin, once per session."""
 
+    def __init__(self, st, model, fmu_bytes):
+        self.st, self.model, self.data = st, model, fmu_bytes
+        self.client = self.cluster = self.plugin = None
 
-def _run_dask(st, model, fmu_bytes, todo, store_batch):
-    from distributed import Client, LocalCluster, as_completed
+    def __enter__(self):
+        if self.st.workers == 0:
+            install_fmu(self.model.guid, self.data)
+            return self
+        from distributed import Client, LocalCluster
 
-    cluster = None
-    if st.scheduler:
-        client = Client(st.scheduler, timeout="30s")
-    else:
-        n = st.workers or os.cpu_count() or 1
-        # no dashboards (no port to find); the study reports its own errors
-        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                               dashboard_address=None, worker_dashboard_address=None,
-                               silence_logs=logging.CRITICAL)
-        client = Client(cluster)
-    try:
-        plug = FMUPlugin(model.guid, fmu_bytes)
-        client.register_plugin(plug)
-        n_workers = max(len(client.scheduler_info()["workers"]), 1)
+        if self.st.scheduler:
+            self.client = Client(self.st.scheduler, timeout="30s")
+        else:
+            n = self.st.workers or os.cpu_count() or 1
+            # no dashboards (no port to find); the study reports its own errors
+            self.cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                                        dashboard_address=None, worker_dashboard_address=None,
+                                        silence_logs=logging.CRITICAL)
+            self.client = Client(self.cluster)
+        self.plugin = FMUPlugin(self.model.guid, self.data)
+        self.client.register_plugin(self.plugin)
+        return self
+
+    def __exit__(self, *exc):
+        if self.client is not None:
+            if exc[0] is None:
+                self.client.unregister_worker_plugin(self.plugin.name)
+            self.client.close()
+        if self.cluster is not None:
+            self.cluster.close(timeout=10)
+
+    def workers(self):
+        return 1 if self.client is None else max(len(self.client.scheduler_info()["workers"]), 1)
+
+    def run(self, st, todo, store_batch):
+        """Run the points [(index, id, values)] in batches; store_batch(rows) as each ends."""
         record = tuple(st.record)
-        futures = [client.submit(run_batch, model.guid, st.duration, record, b, pure=False,
-                                 key=f"gearrattle-batch-{b[0][1]}-{len(b)}")
-                   for b in _batches(todo, batch_size(len(todo), n_workers))]
+        batches = _batches(todo, batch_size(len(todo), self.workers()))
+        if self.client is None:
+            for b in batches:
+                store_batch(run_batch(self.model.guid, st.duration, record, b))
+            return
+        from distributed import as_completed
+
+        # a batch's key names its points: the same key on a shared cluster is the same work
+        futures = [self.client.submit(run_batch, self.model.guid, st.duration, record, b,
+                                      pure=False, key=_key(b)) for b in batches]
         for fut in as_completed(futures):
             store_batch(fut.result())
-        client.unregister_worker_plugin(plug.name)
-    finally:
-        client.close()
-        if cluster is not None:
-            cluster.close(timeout=10)
