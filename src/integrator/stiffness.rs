@@ -55,12 +55,12 @@ pub fn stiffness<const N: usize>(trial: &dopri5::Trial<N>, tol: &Tolerance<N>) -
 }
 
 /// The threshold of h·ρ, both ways. Hairer's DOPRI5 takes 3.25, the radius of DOPRI5's
-/// stability domain on the negative real axis (3.3); but the radius shrinks towards the imaginary axis: 3.3 for real eigenvalues, 3.0 for a contact
-/// mode with damping ratio ζ = 0.2 (where DOPRI5's steps were measured to hover at
-/// h·|λ| = 3.0 ± 0.6 on a resting contact, so that 3.25 never fired), 2.6 for ζ = 0.09,
-/// 2.3 for ζ = 0.035. An accepted step with h·|λ| > 2 leaves that mode an error of about
-/// (h·|λ|)⁶/720 ≈ 9 % of its amplitude per step: it is accepted only when the mode has died
-/// out, which is what stiffness means.
+/// stability domain on the negative real axis (3.3); but the radius shrinks towards the
+/// imaginary axis: 3.3 for real eigenvalues, 3.0 for a contact mode with damping ratio ζ = 0.2
+/// (where DOPRI5's steps hover at h·|λ| = 3.0 ± 0.6 on a resting contact, so that 3.25 would
+/// never fire), 2.6 for ζ = 0.09, 2.3 for ζ = 0.035. An accepted step with h·|λ| > 2 leaves
+/// that mode an error of about (h·|λ|)⁶/720 ≈ 9 % of its amplitude per step: it is accepted
+/// only when the mode has died out, which is what stiffness means.
 pub const STIFF_H_RHO: f64 = 2.0;
 /// Stiff verdicts (not interrupted by 6 non-stiff ones in a row) that make a problem stiff.
 pub const STIFF_STEPS: u32 = 15;

@@ -59,8 +59,8 @@ impl MainShaft {
 pub struct Dynamics {
     pub params: GearParams,
     pub law: ContactLaw,
-    /// 1/r_L and 1/I_L: the right-hand side multiplies by them (two divisions, one waiting
-    /// for the other, were on the path of every stage).
+    /// 1/r_L and 1/I_L: the right-hand side multiplies by them, keeping two chained divisions
+    /// off the path of every stage (docs/DECISIONS.md, D16).
     inv_r_L: f64,
     inv_I_L: f64,
 }
