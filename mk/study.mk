@@ -16,3 +16,20 @@ bench-study: fmu $(VENV)/.installed
 
 # The benchmark's reference solutions depend on the reference, now in the package.
 $(BENCH_REF): python/gearrattle/reference.py
+
+STUDY_EXAMPLES := map_paper mc_idle sobol_s1 doe_backlash_drag
+
+.PHONY: study-examples
+
+## study-examples: the worked examples of docs/STUDIES.md (examples/studies) -> their figures in docs/studies
+study-examples: fmu $(VENV)/.installed
+	@mkdir -p docs/studies
+	@set -e; for s in $(STUDY_EXAMPLES); do \
+		$(VENV)/bin/gearrattle-study run examples/studies/$$s.toml --quiet; \
+		cp target/studies/$$s/summary.txt docs/studies/$$s.txt; \
+	done
+	cp target/studies/map_paper/map_stat_run_mean_Fplus.png docs/studies/map_run_mean_Fplus.png
+	cp target/studies/map_paper/map_stat_rattle_power.png docs/studies/map_rattle_power.png
+	cp target/studies/mc_idle/mc_distributions.png docs/studies/mc_idle.png
+	cp target/studies/sobol_s1/mc_sensitivity.png docs/studies/sobol_s1.png
+	cp target/studies/doe_backlash_drag/doe_stat_rattle_power.png docs/studies/doe_rattle_power.png

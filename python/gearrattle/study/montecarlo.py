@@ -45,8 +45,9 @@ def analyse(st, table, metrics):
         sel = mask & ok
         head = f"at {label}" if label else "over the sample"
         lines.append(f"Monte Carlo {head}: {int(sel.sum())} of {int(mask.sum())} points ok")
-        for m in metrics:
+        for m in metrics:  # a metric undefined at a point (a mean over no impact) is left out
             x = column(table, m)[sel]
+            x = x[np.isfinite(x)]
             if len(x):
                 q = np.percentile(x, PERCENTILES)
                 pct_rows.append([label, m, len(x), np.mean(x), np.std(x, ddof=1) if len(x) > 1
@@ -89,8 +90,8 @@ def _sensitivity(st, table, mask, metrics, label):
     names = prob["names"]
     for m in metrics:
         y = column(table, m)[mask]
-        if np.ptp(y) == 0:
-            continue  # a constant metric has no sensitivity to apportion
+        if not np.isfinite(y).all() or np.ptp(y) == 0:
+            continue  # undefined somewhere, or constant: no variance to apportion
         if st.sensitivity == "sobol":
             from SALib.analyze import sobol
 
@@ -135,7 +136,8 @@ def _figure(st, table, sel, metrics, label, k):
     fig, axes = plt.subplots(rows, cols, figsize=(4 * cols, 2.8 * rows), squeeze=False,
                              constrained_layout=True)
     for ax, m in zip(axes.flat, metrics):
-        x = np.sort(column(table, m)[sel])
+        x = column(table, m)[sel]
+        x = np.sort(x[np.isfinite(x)])
         ax.hist(x, bins=min(40, max(5, len(x) // 20)), color="tab:blue", alpha=0.6)
         ax.set_xlabel(m, fontsize=8)
         ax.tick_params(labelsize=7)

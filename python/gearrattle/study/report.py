@@ -42,8 +42,9 @@ def write(st, model, table, wall):
         lines.append(f"  {'metric':24s} {'min':>11s} {'median':>11s} {'max':>11s}")
         for m in metrics:
             x = column(table, m)[ok]
-            lines.append(f"  {m:24s} {np.nanmin(x):11.4g} {np.nanmedian(x):11.4g} "
-                         f"{np.nanmax(x):11.4g}")
+            x = x[np.isfinite(x)]
+            lines.append(f"  {m:24s} " + (f"{x.min():11.4g} {np.median(x):11.4g} {x.max():11.4g}"
+                                          if len(x) else "undefined at every point"))
     if st.kind == "map" and metrics:
         files += figures.map_figures(st, table, metrics)
     elif st.kind == "doe" and metrics:

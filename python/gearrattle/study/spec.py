@@ -110,11 +110,17 @@ def _float(text, where, what):
         raise StudyError(f"{where}: {what} '{text}' is not a number") from None
 
 
-def parse_axis(text, where):
-    name, rest = _split(text, where, "NAME=LO:HI:COUNT (e.g. f_exc=30:60:16)")
+def _fields(text, where, form, example):
+    """NAME and the colon-separated fields of NAME=A:B[:C] as the form's names say."""
+    name, rest = _split(text, where, f"{form} (e.g. {example})")
     parts = rest.split(":")
-    if len(parts) != 3:
-        raise StudyError(f"{where}: '{text}' is not NAME=LO:HI:COUNT (e.g. f_exc=30:60:16)")
+    if len(parts) != form.count(":") + 1:
+        raise StudyError(f"{where}: '{text}' is not {form} (e.g. {example})")
+    return name, parts
+
+
+def parse_axis(text, where):
+    name, parts = _fields(text, where, "NAME=LO:HI:COUNT", "f_exc=30:60:16")
     lo, hi = (_float(p, where, w) for p, w in zip(parts, ("LO", "HI")))
     try:
         count = int(parts[2])
@@ -127,10 +133,7 @@ def parse_axis(text, where):
 
 
 def parse_range(text, where):
-    name, rest = _split(text, where, "NAME=LO:HI (e.g. G=15e-6:35e-6)")
-    parts = rest.split(":")
-    if len(parts) != 2:
-        raise StudyError(f"{where}: '{text}' is not NAME=LO:HI (e.g. G=15e-6:35e-6)")
+    name, parts = _fields(text, where, "NAME=LO:HI", "G=15e-6:35e-6")
     lo, hi = (_float(p, where, w) for p, w in zip(parts, ("LO", "HI")))
     if not lo < hi:
         raise StudyError(f"{where}: empty range {name} = {lo:g}..{hi:g}: give LO < HI")
