@@ -63,6 +63,9 @@ struct Variable {
     min: Option<toml::Value>,
     max: Option<toml::Value>,
     depends_on: Option<Vec<String>>,
+    /// The FMU gives this output's first time derivative (fmi2GetRealOutputDerivatives).
+    #[serde(default)]
+    derivative: bool,
 }
 
 impl Variable {
@@ -122,6 +125,11 @@ fn check(c: &Contract) {
                 v.name
             );
         }
+        assert!(
+            !v.derivative || (v.causality == "output" && v.ty == "Real"),
+            "{}: only Real outputs have derivatives",
+            v.name
+        );
         for d in v.depends_on.iter().flatten() {
             assert!(
                 c.variable
@@ -306,7 +314,11 @@ fn rust(c: &Contract, guid: &str) -> String {
     for (n, d) in &c.log_categories {
         writeln!(r, "    ({n:?}, {d:?}),").unwrap();
     }
-    r += "];\n\n/// Value references, named as the variables.\n#[allow(non_upper_case_globals)]\npub mod vr {\n";
+    r += "];\n\n/// Indices in LOG_CATEGORIES, named as the categories.\n#[allow(non_upper_case_globals)]\npub mod log {\n";
+    for (i, (n, _)) in c.log_categories.iter().enumerate() {
+        writeln!(r, "    pub const {n}: usize = {i};").unwrap();
+    }
+    r += "}\n\n/// Value references, named as the variables.\n#[allow(non_upper_case_globals)]\npub mod vr {\n";
     for v in &c.variable {
         writeln!(r, "    pub const {}: u32 = {};", v.name, v.vr).unwrap();
     }
@@ -329,8 +341,14 @@ fn rust(c: &Contract, guid: &str) -> String {
         };
         writeln!(
             r,
-            "    Variable {{ name: {:?}, vr: {}, kind: Kind::{}, causality: Causality::{causality}, start: {start}, unit: {:?}, description: {:?} }},",
-            v.name, v.vr, v.ty, v.unit.as_deref().unwrap_or(""), v.description
+            "    Variable {{ name: {:?}, vr: {}, kind: Kind::{}, causality: Causality::{causality}, start: {start}, unit: {:?}, depends_on: &{:?}, derivative: {}, description: {:?} }},",
+            v.name,
+            v.vr,
+            v.ty,
+            v.unit.as_deref().unwrap_or(""),
+            v.depends_on.as_deref().unwrap_or_default(),
+            v.derivative,
+            v.description
         )
         .unwrap();
     }

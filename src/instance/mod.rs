@@ -27,10 +27,11 @@ pub struct Message {
     pub text: String,
 }
 
-const ERRORS: usize = 0;
-const WARNINGS: usize = 1;
-const EVENTS: usize = 2;
-const STEPS: usize = 3;
+/// The contract's log categories by role.
+const ERRORS: usize = contract::log::logStatusError;
+const WARNINGS: usize = contract::log::logStatusWarning;
+const EVENTS: usize = contract::log::logEvents;
+const STEPS: usize = contract::log::logStep;
 
 /// One co-simulation instance. Everything but the logging settings and the queued lines is
 /// its FMU state (fmi2GetFMUstate / fmi2SerializeFMUstate): parameters, inputs, time, the
@@ -369,8 +370,9 @@ impl Instance {
                 (1, Some(d)) => d,
                 _ => {
                     return Err(FmiError::error(format!(
-                        "no derivative of order {order} for {}: order 1 is given for xi, xi_dot, theta_L, omega_L, F_contact, tau_M, theta_M_out, omega_M_out",
-                        var.name
+                        "no derivative of order {order} for {}: order 1 is given for {}",
+                        var.name,
+                        contract::with_derivative().collect::<Vec<_>>().join(", ")
                     )));
                 }
             };
