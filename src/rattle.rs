@@ -2,30 +2,32 @@
 //! right-hand side (MODEL.md §3 plus the dissipated energies and the shaft's work as
 //! quadratures), the region as the current piece, and the impact counters (MODEL.md §1: an
 //! impact is ξ leaving the gap, across 0 downwards on F+ or G upwards on F−). [`torque`] is
-//! the same gear pair with the main shaft an inertia driven by a torque (torque mode).
+//! the same gear pair with the main shaft an inertia driven by a torque (torque mode);
+//! [`window`] the rattle statistics over a window of time.
 #![allow(non_snake_case)]
 
 pub mod torque;
+pub mod window;
 
 use serde::{Deserialize, Serialize};
 
 use crate::integrator::taylor::{Coefficients, TERMS};
-use crate::integrator::{Edge, Jacobian, Piecewise, System, Tolerance};
+use crate::integrator::{Dense, Edge, Jacobian, Piecewise, System, Tolerance};
 use crate::math;
 use crate::physics::{
-    ContactSeries, Dynamics, Excitation, Flight, FlightStart, GearParams, Loads, Region, Shaft,
+    ContactSeries, Dynamics, Excitation, Flight, FlightStart, FlightState, GearParams, Loads,
+    Region, Shaft,
 };
+use window::{Quadratures, Window, quadrature};
 
-/// Components of the state vector.
+/// Components of the state vector: ξ, ξ', then the quadratures of [`window::quadrature`]
+/// (the dissipated energies, the shaft's work, ∫a² dt, ∫F dt, ∫F² dt).
 pub const XI: usize = 0;
 pub const XI_DOT: usize = 1;
-/// ∫ F_c ξ' dt: energy dissipated in the contact damping [J].
 pub const E_CONTACT: usize = 2;
-/// ∫ C (ω_L − ω_S)² dt: energy dissipated by the lubricant [J].
-pub const E_LUBRICANT: usize = 3;
-/// ∫ −τ_M ω_M dt: work the main shaft feeds into the loose gear [J].
-pub const W_SHAFT: usize = 4;
-pub const N: usize = 5;
+pub const E_LUBRICANT: usize = E_CONTACT + quadrature::E_LUBRICANT;
+pub const W_SHAFT: usize = E_CONTACT + quadrature::W_SHAFT;
+pub const N: usize = E_CONTACT + quadrature::COUNT;
 
 pub type State = [f64; N];
 
@@ -45,18 +47,22 @@ pub struct Rattle {
     pub region: Region,
     pub excitation: Excitation,
     pub impacts: Impacts,
+    pub window: Window,
     /// The start of the free flight the solver is passing through, kept for its points
     /// ([`Piecewise::prepare_exact`]).
     flight_start: Option<FlightStart>,
 }
 
 impl Rattle {
+    /// The pair at ξ, with no statistics window (one opens with [`GearPair::with_window`]).
     pub fn new(dynamics: Dynamics, excitation: Excitation, xi: f64) -> Self {
+        let region = dynamics.law.classify(xi);
         Rattle {
-            region: dynamics.law.classify(xi),
+            region,
             dynamics,
             excitation,
             impacts: Impacts::default(),
+            window: Window::closed(region),
             flight_start: None,
         }
     }
@@ -70,25 +76,47 @@ impl Rattle {
     pub fn tolerance(&self, rtol: f64) -> Tolerance<N> {
         let rtol = rtol * LOCAL_SHARE;
         let (xi_scale, xi_dot_scale) = scales(&self.dynamics.params);
+        let mut atol = [0.0; N];
+        (atol[XI], atol[XI_DOT]) = (rtol * xi_scale, rtol * xi_dot_scale);
         Tolerance {
             rtol,
-            atol: [rtol * xi_scale, rtol * xi_dot_scale, 0.0, 0.0, 0.0],
+            atol,
             controlled: 2,
         }
     }
 }
 
 /// What the co-simulation reads from the gear pair whatever drives its main shaft: ξ and ξ'
-/// are the components `GUARD` and `RATE`; the dissipated energies sit at `E_CONTACT` and
-/// `E_LUBRICANT`.
+/// are the components `GUARD` and `RATE`; the quadratures of [`window::quadrature`] follow
+/// each other from `E_CONTACT` on.
 pub trait GearPair<const N: usize>: Piecewise<N> {
     const E_CONTACT: usize;
-    const E_LUBRICANT: usize;
     fn dynamics(&self) -> &Dynamics;
     fn region(&self) -> Region;
     fn impacts(&self) -> &Impacts;
+    fn window(&self) -> &Window;
+    fn window_mut(&mut self) -> &mut Window;
+    /// The pair starting at t0 with its statistics window opening at `stats_from`.
+    fn with_window(mut self, t0: f64, stats_from: f64) -> Self
+    where
+        Self: Sized,
+    {
+        let region = self.region();
+        *self.window_mut() = Window::new(stats_from, t0, region);
+        self
+    }
     /// θ_M, ω_M and a_M of the main shaft at (t, y).
     fn shaft(&self, t: f64, y: &[f64; N]) -> Shaft;
+    /// The loads at (t, y) in the current region.
+    fn loads_at(&self, t: f64, y: &[f64; N]) -> Loads {
+        let shaft = self.shaft(t, y);
+        let (xi, xi_dot) = (y[Self::GUARD], y[Self::RATE]);
+        self.dynamics().loads(self.region(), xi, xi_dot, &shaft)
+    }
+    /// The quadratures at y.
+    fn quadratures(y: &[f64; N]) -> Quadratures {
+        std::array::from_fn(|i| y[Self::E_CONTACT + i])
+    }
 }
 
 /// Share of the requested tolerance given to each step's local error. The request is read as
@@ -106,12 +134,14 @@ pub(crate) fn scales(p: &GearParams) -> (f64, f64) {
     (p.G, p.G * p.contact_frequency().min(FLIGHT_RATE))
 }
 
-/// The region entered through `edge`; an onset counted in `impacts` when it leaves the gap.
+/// The region entered through `edge` at t: an onset counted in `impacts` and in the window
+/// when it leaves the gap, a separation in the window when it enters it.
 pub(crate) fn cross_edge(
     dynamics: &Dynamics,
     region: Region,
-    impacts: &mut Impacts,
+    (impacts, window): (&mut Impacts, &mut Window),
     edge: Edge,
+    t: f64,
     xi_dot: f64,
 ) -> Region {
     let law = &dynamics.law;
@@ -119,11 +149,16 @@ pub(crate) fn cross_edge(
         let flank = if edge == Edge::Lower { 0 } else { 1 };
         impacts.count[flank] += 1;
         impacts.last_speed = xi_dot.abs();
+        window.impact(t, flank, xi_dot.abs());
     }
-    match edge {
+    let entered = match edge {
         Edge::Lower => law.below(region),
         Edge::Upper => law.above(region),
+    };
+    if entered == Region::Gap {
+        window.separation(t);
     }
+    entered
 }
 
 impl System<N> for Rattle {
@@ -140,23 +175,107 @@ impl Rattle {
     pub fn rhs_in(&self, region: Region, t: f64, y: &State) -> State {
         let shaft = self.excitation.at(t);
         let loads = self.dynamics.loads(region, y[XI], y[XI_DOT], &shaft);
-        let p = &self.dynamics.params;
-        let [e_contact, e_lubricant, w_shaft] = power_flows(p, &loads, y[XI_DOT], shaft.omega);
-        [y[XI_DOT], loads.xi_ddot, e_contact, e_lubricant, w_shaft]
+        let q = quadrature_rates(&self.dynamics.params, &loads, y[XI_DOT], shaft.omega);
+        let mut f = [0.0; N];
+        (f[XI], f[XI_DOT]) = (y[XI_DOT], loads.xi_ddot);
+        f[E_CONTACT..].copy_from_slice(&q);
+        f
     }
 }
 
-/// The rates of the quadratures (MODEL.md §3's energy balance): the power lost in the contact
-/// damping F_c ξ', in the lubricant C (ω_L − ω_S)², and the power −τ_M ω_M the main shaft
-/// feeds in.
+/// The rates of the quadratures of [`window::quadrature`]: MODEL.md §3's energy balance (the
+/// power lost in the contact damping F_c ξ', in the lubricant C (ω_L − ω_S)², the power
+/// −τ_M ω_M the main shaft feeds in), then a², F and F² with a = r_L α_L.
 #[inline]
-pub(crate) fn power_flows(p: &GearParams, loads: &Loads, xi_dot: f64, omega_M: f64) -> [f64; 3] {
+pub(crate) fn quadrature_rates(
+    p: &GearParams,
+    loads: &Loads,
+    xi_dot: f64,
+    omega_M: f64,
+) -> Quadratures {
     let slip = loads.omega_L - p.omega_S;
+    let force = loads.force.total();
+    let a = p.r_L * loads.alpha_L;
     [
         loads.force.dissipative * xi_dot,
         p.C * slip * slip,
-        -p.r_M * loads.force.total() * omega_M,
+        -p.r_M * force * omega_M,
+        a * a,
+        force,
+        force * force,
     ]
+}
+
+/// The largest |a| on an accepted step from t0 of length h, for the window, and |a| at its
+/// end: a at the step's ends (the start's from the step before, when it ended at t0) and
+/// middle, and, where the parabola through them peaks inside the step above the window's
+/// peak so far, that peak located by successive parabolic interpolation on the dense output.
+/// Points outside the current piece (past an edge the step is redone to end on) are not the
+/// piece's and are left out.
+pub(crate) fn step_peak<S: GearPair<N>, D: Dense<N>, const N: usize>(
+    sys: &S,
+    t0: f64,
+    h: f64,
+    step: &D,
+) -> (f64, f64) {
+    let (lo, hi) = sys.piece();
+    let window = sys.window();
+    let r_L = sys.dynamics().params.r_L;
+    let a_at = |theta: f64| {
+        let t = t0 + theta * h;
+        // The loads read only the dynamic components, before the quadratures.
+        let mut y = [0.0; N];
+        for (i, y) in y.iter_mut().enumerate().take(S::E_CONTACT) {
+            *y = step.dense(i, theta);
+        }
+        let xi = y[S::GUARD];
+        if xi < lo || xi > hi || t < window.from {
+            return 0.0;
+        }
+        (r_L * sys.loads_at(t, &y).alpha_L).abs()
+    };
+    let a0 = match window.last {
+        Some((t, a)) if t == t0 => a,
+        _ => a_at(0.0),
+    };
+    let mut points = [(0.0, a0), (0.5, a_at(0.5)), (1.0, a_at(1.0))];
+    let a_end = points[2].1;
+    let mut peak = a0.max(points[1].1).max(a_end);
+    for _ in 0..PEAK_ITERATIONS {
+        let Some(theta) = parabola_peak(&points)
+            .filter(|&(x, y)| (0.0..=1.0).contains(&x) && y > peak.max(window.a_peak))
+            .map(|(x, _)| x)
+        else {
+            break;
+        };
+        let value = a_at(theta);
+        peak = peak.max(value);
+        // The three points around the largest value so far bracket the next vertex.
+        let mut all = [points[0], points[1], points[2], (theta, value)];
+        all.sort_by(|p, q| p.0.total_cmp(&q.0));
+        let best = (1..3)
+            .max_by(|&i, &j| all[i].1.total_cmp(&all[j].1))
+            .unwrap_or(1);
+        points = [all[best - 1], all[best], all[best + 1]];
+    }
+    (peak, a_end)
+}
+
+/// Vertices of successive parabolas tried per step: each adds about three correct digits to
+/// the peak's position near a smooth maximum.
+const PEAK_ITERATIONS: usize = 3;
+
+/// Where the parabola through three points (in increasing x) peaks, and its value there;
+/// None unless it opens downwards.
+fn parabola_peak(p: &[(f64, f64); 3]) -> Option<(f64, f64)> {
+    let [(x0, y0), (x1, y1), (x2, y2)] = *p;
+    let (s01, s12) = ((y1 - y0) / (x1 - x0), (y2 - y1) / (x2 - x1));
+    let curvature = (s12 - s01) / (x2 - x0);
+    // y = y0 + s01 (x − x0) + curvature (x − x0)(x − x1), whose slope vanishes at the vertex.
+    (curvature < 0.0).then(|| {
+        let x = 0.5 * (x0 + x1) - 0.5 * s01 / curvature;
+        (x, y0 + s01 * (x - x0) + curvature * (x - x0) * (x - x1))
+    })
 }
 
 impl Jacobian<N> for Rattle {
@@ -178,15 +297,14 @@ impl Jacobian<N> for Rattle {
 }
 
 /// `GearPair` and `Piecewise` for a gear pair with fields `dynamics`, `region` and `impacts`,
-/// and ξ, ξ', the energies at the components `XI`, `XI_DOT`, `E_CONTACT`, `E_LUBRICANT` of its
-/// `N`-state (names resolved where it is used). `$shaft` is the pair's `GearPair::shaft`; the
+/// and `window`, and ξ, ξ', the quadratures at the components `XI`, `XI_DOT`, `E_CONTACT` on
+/// of its `N`-state (names resolved where it is used). `$shaft` is the pair's `GearPair::shaft`; the
 /// pieces are the contact law's regions, and crossing out of the gap counts an impact;
 /// `$extra` items go into the `Piecewise` impl.
 macro_rules! contact_pieces {
     ($gear:ty, $shaft:item $(, $extra:item)*) => {
         impl $crate::rattle::GearPair<N> for $gear {
             const E_CONTACT: usize = E_CONTACT;
-            const E_LUBRICANT: usize = E_LUBRICANT;
             fn dynamics(&self) -> &$crate::physics::Dynamics {
                 &self.dynamics
             }
@@ -195,6 +313,12 @@ macro_rules! contact_pieces {
             }
             fn impacts(&self) -> &$crate::rattle::Impacts {
                 &self.impacts
+            }
+            fn window(&self) -> &$crate::rattle::window::Window {
+                &self.window
+            }
+            fn window_mut(&mut self) -> &mut $crate::rattle::window::Window {
+                &mut self.window
             }
             $shaft
         }
@@ -213,14 +337,29 @@ macro_rules! contact_pieces {
                 self.dynamics.law.rough_at_onset(self.region)
             }
 
-            fn cross(&mut self, edge: $crate::integrator::Edge, _t: f64, y: &[f64; N]) {
+            fn cross(&mut self, edge: $crate::integrator::Edge, t: f64, y: &[f64; N]) {
+                use $crate::rattle::GearPair;
+                if self.window.is_open_at(t) {
+                    let a = self.dynamics.params.r_L * self.loads_at(t, y).alpha_L;
+                    self.window.acceleration(t, a);
+                    self.window.last = Some((t, a.abs()));
+                }
                 self.region = $crate::rattle::cross_edge(
                     &self.dynamics,
                     self.region,
-                    &mut self.impacts,
+                    (&mut self.impacts, &mut self.window),
                     edge,
+                    t,
                     y[XI_DOT],
                 );
+            }
+
+            fn observe<D: $crate::integrator::Dense<N>>(&mut self, t0: f64, h: f64, step: &D) {
+                if self.window.is_open_at(t0 + h) {
+                    let (peak, end) = $crate::rattle::step_peak(self, t0, h, step);
+                    self.window.acceleration(t0 + h, peak);
+                    self.window.last = Some((t0 + h, end));
+                }
             }
         }
     };
@@ -246,7 +385,8 @@ contact_pieces!(
         y[XI] = f.xi;
         y[XI_DOT] = f.xi_dot;
         y[E_LUBRICANT] += f.e_lubricant;
-        // No contact force in the gap: E_CONTACT and W_SHAFT stay.
+        y[E_CONTACT + quadrature::A2] += self.flight_a2(t - t0, &f);
+        // No contact force in the gap: E_CONTACT, W_SHAFT, ∫F and ∫F² stay.
         y
     },
     fn guard_acceleration_bound(&self, t0: f64, y0: &State) -> f64 {
@@ -261,7 +401,7 @@ contact_pieces!(
 
 impl Rattle {
     /// Taylor coefficients of the state in full contact (see [`ContactSeries`]); the
-    /// quadratures' are those of their rates (`power_flows`) integrated term by term.
+    /// quadratures' are those of their rates (`quadrature_rates`) integrated term by term.
     fn contact_series(&self, t: f64, y: &State, c: &mut Coefficients<N>) -> bool {
         let Some(s) = ContactSeries::<{ TERMS + 1 }>::new(
             &self.dynamics,
@@ -288,24 +428,41 @@ impl Rattle {
         });
         let force: [f64; RATES] = std::array::from_fn(|k| s.force[k]);
         let omega_M: [f64; RATES] = std::array::from_fn(|k| s.omega_M[k]);
+        // a = r_L α_L = (r_L / I_L) (B − r_L F − C (ω_L − ω_S)).
+        let lever = p.r_L / p.I_L;
+        let a: [f64; RATES] = std::array::from_fn(|k| {
+            lever * (if k == 0 { p.B } else { 0.0 } - p.r_L * force[k] - p.C * slip[k])
+        });
         let contact = math::series_product(&xi_dot, &xi_dot);
         let lubricant = math::series_product(&slip, &slip);
         let shaft = math::series_product(&force, &omega_M);
-        c[0][E_CONTACT] = y[E_CONTACT];
-        c[0][E_LUBRICANT] = y[E_LUBRICANT];
-        c[0][W_SHAFT] = y[W_SHAFT];
+        let a2 = math::series_product(&a, &a);
+        let f2 = math::series_product(&force, &force);
+        c[0][E_CONTACT..].copy_from_slice(&y[E_CONTACT..]);
         for (k, row) in c.iter_mut().enumerate().skip(1) {
             // The coefficient k − 1 of each rate, integrated: / k.
             let inv_k = math::INVERSES[k];
             row[E_CONTACT] = p.C_LM * contact[k - 1] * inv_k;
             row[E_LUBRICANT] = p.C * lubricant[k - 1] * inv_k;
             row[W_SHAFT] = -p.r_M * shaft[k - 1] * inv_k;
+            row[E_CONTACT + quadrature::A2] = a2[k - 1] * inv_k;
+            row[E_CONTACT + quadrature::F1] = force[k - 1] * inv_k;
+            row[E_CONTACT + quadrature::F2] = f2[k - 1] * inv_k;
         }
         true
     }
 }
 
 impl Rattle {
+    /// ∫ a² dτ over a free flight of length τ that ends in `f`: in the gap
+    /// a = (r_L / I_L) (B − C u) with u = ω_L − ω_S, so the integral is
+    /// (r_L / I_L)² (B² τ − 2 B C ∫u dτ + C ∫C u² dτ), the last being the lubricant's energy.
+    fn flight_a2(&self, tau: f64, f: &FlightState) -> f64 {
+        let p = &self.dynamics.params;
+        let lever = p.r_L / p.I_L;
+        lever * lever * (p.B * (p.B * tau - 2.0 * p.C * f.slip_integral) + p.C * f.e_lubricant)
+    }
+
     /// The free flight from (t0, y0), from its kept start if it is that one.
     fn flight(&self, t0: f64, y0: &State) -> Flight<'_> {
         let (params, excitation) = (&self.dynamics.params, &self.excitation);
@@ -325,6 +482,16 @@ mod tests {
     use super::*;
     use crate::physics::{GearParams, Sine};
 
+    /// A state at (ξ, ξ') with the quadratures `q0`, `q0` + 1e-6, ...
+    fn state(xi: f64, xi_dot: f64, q0: f64) -> State {
+        let mut y = [0.0; N];
+        (y[XI], y[XI_DOT]) = (xi, xi_dot);
+        for (k, q) in y[E_CONTACT..].iter_mut().enumerate() {
+            *q = q0 + 1e-6 * k as f64;
+        }
+        y
+    }
+
     /// The Jacobian matches central differences of the right-hand side in every region, for
     /// the rows of ξ and ξ' (the quadratures' rows are zero on purpose, see `jacobian`).
     #[test]
@@ -334,7 +501,7 @@ mod tests {
         let xis = [-3e-6, -0.7e-6, -0.2e-6, 10e-6, p.G + 0.4e-6, p.G + 3e-6];
         for xi in xis {
             let rattle = Rattle::new(Dynamics::new(p), excitation, xi);
-            let y = [xi, 0.03, 0.0, 0.0, 0.0];
+            let y = state(xi, 0.03, 0.0);
             let j = rattle.jacobian(0.004, &y);
             for (col, step) in [(XI, 1e-12), (XI_DOT, 1e-7)] {
                 let (mut up, mut down) = (y, y);
@@ -378,7 +545,7 @@ mod tests {
         for excitation in [Excitation::Sine(Sine::new(300.0, 30.0, 84.0)), polynomial] {
             for (xi, xi_dot) in [(-3e-6, 0.004), (p.G + 2e-6, -0.005)] {
                 let rattle = Rattle::new(Dynamics::new(p), excitation, xi);
-                let (t0, y0) = (0.0123, [xi, xi_dot, 1e-6, 2e-6, 3e-6]);
+                let (t0, y0) = (0.0123, state(xi, xi_dot, 1e-6));
                 let mut c = [[0.0; N]; TERMS];
                 assert!(rattle.series(t0, &y0, &mut c));
                 let f0 = rattle.rhs(t0, &y0);
@@ -398,7 +565,8 @@ mod tests {
                     (t, y) = (t + h, trial.y1);
                 }
                 let taylor = crate::integrator::taylor::Step::new(c, t - t0);
-                let scales = [p.G, p.G * 1e3, 1e-6, 1e-6, 1e-6];
+                let mut scales = [1e-6; N];
+                (scales[XI], scales[XI_DOT]) = (p.G, p.G * 1e3);
                 for i in 0..N {
                     let err = (taylor.y1[i] - y[i]).abs() / scales[i].max(y[i].abs());
                     assert!(
@@ -416,7 +584,7 @@ mod tests {
             Excitation::Sine(Sine::new(300.0, 30.0, 84.0)),
             1e-5,
         );
-        assert!(!gap.series(0.0, &[1e-5, 0.0, 0.0, 0.0, 0.0], &mut [[0.0; N]; TERMS]));
+        assert!(!gap.series(0.0, &state(1e-5, 0.0, 0.0), &mut [[0.0; N]; TERMS]));
     }
 
     /// With `interpolate_ends`, the end times asked for change no bit of the trajectory:
@@ -435,7 +603,7 @@ mod tests {
             );
             let mut solver = Solver::new(sys.tolerance(1e-6));
             solver.interpolate_ends = true;
-            let (mut t, mut y) = (0.0, [0.5 * p.G, 0.0, 0.0, 0.0, 0.0]);
+            let (mut t, mut y) = (0.0, state(0.5 * p.G, 0.0, 0.0));
             let n = (0.03125 / dt) as usize;
             let every = (2f64.powi(-10) / dt) as usize;
             let mut at_common = vec![];
@@ -464,17 +632,55 @@ mod tests {
         let excitation = Excitation::Sine(Sine::new(300.0, 30.0, 84.0));
         let fresh = Rattle::new(Dynamics::new(p), excitation, 10e-6);
         assert_eq!(fresh.region, Region::Gap);
-        let (t0, y0) = (0.0123, [10e-6, -0.04, 1e-3, 2e-3, 3e-3]);
+        let (t0, y0) = (0.0123, state(10e-6, -0.04, 1e-3));
         let mut kept = fresh;
         kept.prepare_exact(t0, &y0);
         for t in [t0, 0.0124, 0.02] {
             assert_eq!(kept.exact(t0, &y0, t), fresh.exact(t0, &y0, t));
         }
-        let other = [11e-6, -0.04, 0.0, 0.0, 0.0];
+        let other = state(11e-6, -0.04, 0.0);
         assert_eq!(
             kept.exact(t0, &other, 0.013),
             fresh.exact(t0, &other, 0.013)
         );
         assert_ne!(kept.exact(t0, &other, 0.013), kept.exact(t0, &y0, 0.013));
+    }
+
+    /// The free flight's quadratures in closed form against small DOPRI5 steps of the
+    /// right-hand side across the gap (with B, C and ω_S all non-zero, so that every term of
+    /// `flight_a2` counts): ∫a² and the lubricant's energy agree within 1e-9, ∫F and ∫F² stay.
+    #[test]
+    fn flight_quadratures_follow_the_right_hand_side() {
+        use crate::integrator::dopri5::{Trial, step};
+        let mut p = GearParams::paper();
+        (p.B, p.omega_S) = (0.02, 3.0);
+        let rattle = Rattle::new(
+            Dynamics::new(p),
+            Excitation::Sine(Sine::new(300.0, 30.0, 84.0)),
+            10e-6,
+        );
+        let (t0, y0) = (0.0123, state(10e-6, -0.004, 1e-6));
+        let (mut t, mut y, h) = (t0, y0, 1e-6);
+        let mut trial = Trial::empty();
+        for _ in 0..1000 {
+            step(&rattle, t, &y, &rattle.rhs(t, &y), h, N, &mut trial);
+            (t, y) = (t + h, trial.y1);
+        }
+        let exact = rattle.exact(t0, &y0, t);
+        for i in [E_LUBRICANT, E_CONTACT + quadrature::A2] {
+            let (gain, want) = (exact[i] - y0[i], y[i] - y0[i]);
+            assert!(
+                want > 0.0 && (gain - want).abs() <= 1e-9 * want,
+                "{i}: {gain} vs {want}"
+            );
+        }
+        for i in [
+            E_CONTACT,
+            W_SHAFT,
+            E_CONTACT + quadrature::F1,
+            E_CONTACT + quadrature::F2,
+        ] {
+            assert_eq!(exact[i], y0[i]);
+        }
     }
 }

@@ -16,6 +16,7 @@ use crate::physics::{
     Dynamics, Excitation, GearParams, MainShaft, Polynomial, Region, Shaft, Sine, TorqueRamp,
 };
 use crate::rattle::torque::{self, TorqueRattle};
+use crate::rattle::window::{Metrics, Quadratures, Window, quadrature};
 use crate::rattle::{self, GearPair, Impacts, Rattle};
 
 /// Values of the `excitation` parameter.
@@ -46,10 +47,34 @@ pub struct Stepped<S, const N: usize> {
 }
 
 impl<S: GearPair<N> + Jacobian<N> + Copy, const N: usize> Stepped<S, N> {
+    /// Advances to t_end, through the opening of the statistics window on the way, where its
+    /// quadratures are kept; on failure the pair, its solver and t are left as they were.
+    fn advance(&mut self, t: &mut f64, t_end: f64) -> Result<(), SolverError> {
+        let window = self.system.window();
+        if window.is_opened() || window.from > t_end {
+            return self.advance_to(t, t_end);
+        }
+        let (before, t_before) = (*self, *t);
+        let advanced = self.advance_to(t, window.from).and_then(|()| {
+            self.open_window();
+            self.advance_to(t, t_end)
+        });
+        if advanced.is_err() {
+            (*self, *t) = (before, t_before);
+        }
+        advanced
+    }
+
+    /// The statistics window opens now: its quadratures are kept.
+    fn open_window(&mut self) {
+        let q = S::quadratures(&self.y);
+        self.system.window_mut().open(q);
+    }
+
     /// Advances to t_end; on failure the pair, its solver and t are left as they were. A
     /// call served from the solver's kept step cannot fail and needs no copy to roll back to
     /// (at 10 µs communication steps most are).
-    fn advance(&mut self, t: &mut f64, t_end: f64) -> Result<(), SolverError> {
+    fn advance_to(&mut self, t: &mut f64, t_end: f64) -> Result<(), SolverError> {
         if self.solver.serve(&self.system, t, &mut self.y, t_end) {
             return Ok(());
         }
@@ -69,8 +94,8 @@ impl<S: GearPair<N> + Jacobian<N> + Copy, const N: usize> Stepped<S, N> {
             impacts: sys.impacts(),
             xi: y[S::GUARD],
             xi_dot: y[S::RATE],
-            e_contact: y[S::E_CONTACT],
-            e_lubricant: y[S::E_LUBRICANT],
+            quadratures: S::quadratures(y),
+            window: sys.window(),
             stats: &self.solver.stats,
             implicit: self.solver.is_implicit(),
         }
@@ -105,8 +130,8 @@ struct Now<'a> {
     impacts: &'a Impacts,
     xi: f64,
     xi_dot: f64,
-    e_contact: f64,
-    e_lubricant: f64,
+    quadratures: Quadratures,
+    window: &'a Window,
     stats: &'a Stats,
     /// Radau IIA is stepping now.
     implicit: bool,
@@ -116,6 +141,13 @@ impl Now<'_> {
     fn loads(&self, shaft: &Shaft) -> crate::physics::Loads {
         self.dynamics
             .loads(self.region, self.xi, self.xi_dot, shaft)
+    }
+
+    /// The statistics window's figures at t.
+    fn metrics(&self, t: f64) -> Metrics {
+        let p = &self.dynamics.params;
+        self.window
+            .metrics(t, &self.quadratures, p.I_L / (p.r_L * p.r_L))
     }
 }
 
@@ -178,12 +210,19 @@ impl Simulation {
         let gap_start = param(values, vr::gap_start);
         let xi_dot_start = param(values, vr::xi_dot_start);
         let I_M = param(values, vr::I_M);
+        let stats_from = param(values, vr::stats_from);
         check("f_exc", f_exc, f_exc > 0.0, "finite and > 0")?;
         check("A_rms", a_rms, true, "finite")?;
         check("omega_mean", omega_mean, true, "finite")?;
         check("gap_start", gap_start, true, "finite")?;
         check("xi_dot_start", xi_dot_start, true, "finite")?;
         check("I_M", I_M, I_M > 0.0, "finite and > 0")?;
+        check(
+            "stats_from",
+            stats_from,
+            stats_from >= 0.0,
+            "finite and >= 0",
+        )?;
         let shaft = Shaft {
             theta: param(values, vr::theta_M),
             omega: param(values, vr::omega_M),
@@ -212,7 +251,8 @@ impl Simulation {
                     tau0: tau,
                     rate,
                 };
-                let system = TorqueRattle::new(dynamics, MainShaft { I_M }, ramp, xi);
+                let system = TorqueRattle::new(dynamics, MainShaft { I_M }, ramp, xi)
+                    .with_window(t0, stats_from);
                 let mut y = [0.0; torque::N];
                 y[torque::XI] = xi;
                 y[torque::XI_DOT] = xi_dot_start;
@@ -225,7 +265,8 @@ impl Simulation {
                 })
             }
             _ => {
-                let system = Rattle::new(dynamics, Self::excitation_from(drive, t0), xi);
+                let excitation = Self::excitation_from(drive, t0);
+                let system = Rattle::new(dynamics, excitation, xi).with_window(t0, stats_from);
                 let mut y = [0.0; rattle::N];
                 y[rattle::XI] = xi;
                 y[rattle::XI_DOT] = xi_dot_start;
@@ -237,7 +278,14 @@ impl Simulation {
                 Gear::Kinematic(Stepped { solver, system, y })
             }
         };
-        Ok(Simulation { gear, t: t0, drive })
+        let mut sim = Simulation { gear, t: t0, drive };
+        // A window that opens at the start keeps the initial quadratures.
+        match &mut sim.gear {
+            Gear::Kinematic(k) if k.system.window.from <= t0 => k.open_window(),
+            Gear::Torque(k) if k.system.window.from <= t0 => k.open_window(),
+            _ => {}
+        }
+        Ok(sim)
     }
 
     /// The imposed motion of the shaft for a kinematic drive.
@@ -354,8 +402,8 @@ impl Simulation {
             vr::F_contact => loads().force.total(),
             vr::tau_M => dynamics.tau_M(&loads()),
             vr::impact_speed => now.impacts.last_speed,
-            vr::E_contact => now.e_contact,
-            vr::E_lubricant => now.e_lubricant,
+            vr::E_contact => now.quadratures[quadrature::E_CONTACT],
+            vr::E_lubricant => now.quadratures[quadrature::E_LUBRICANT],
             vr::theta_M_out => shaft().theta,
             vr::omega_M_out => shaft().omega,
             vr::alpha_M_out => shaft().alpha,
@@ -363,7 +411,7 @@ impl Simulation {
             vr::solver_rejected => now.stats.rejected as f64,
             vr::solver_rhs => now.stats.rhs_evals as f64,
             vr::solver_implicit_steps => now.stats.implicit_steps as f64,
-            _ => return None,
+            _ => return stat_real(&now.metrics(self.t), vr),
         })
     }
 
@@ -448,7 +496,53 @@ impl Simulation {
                     1
                 }
             }
-            _ => return None,
+            _ => return stat_integer(&now.metrics(self.t), vr),
         })
     }
+}
+
+/// A Real stat_* output from the window's figures; None if `vr` is none of them.
+fn stat_real(m: &Metrics, vr: u32) -> Option<f64> {
+    let [plus, minus] = &m.flanks;
+    let per_second = |x: f64| if m.length > 0.0 { x / m.length } else { 0.0 };
+    Some(match vr {
+        vr::stat_window => m.length,
+        vr::stat_impact_rate_Fplus => per_second(plus.impacts as f64),
+        vr::stat_impact_rate_Fminus => per_second(minus.impacts as f64),
+        vr::stat_run_mean_Fplus => plus.run_mean(),
+        vr::stat_run_mean_Fminus => minus.run_mean(),
+        vr::stat_v_mean_Fplus => plus.v_mean(),
+        vr::stat_v_mean_Fminus => minus.v_mean(),
+        vr::stat_v_rms_Fplus => plus.v_rms(),
+        vr::stat_v_rms_Fminus => minus.v_rms(),
+        vr::stat_v_max_Fplus => plus.v_max,
+        vr::stat_v_max_Fminus => minus.v_max,
+        vr::stat_E_impact_Fplus => m.impact_energy[0],
+        vr::stat_E_impact_Fminus => m.impact_energy[1],
+        vr::stat_rattle_power => per_second(m.impact_energy[0] + m.impact_energy[1]),
+        vr::stat_a_rms => m.a_rms,
+        vr::stat_a_peak => m.a_peak,
+        vr::stat_F_std => m.F_std,
+        vr::stat_contact_fraction => m.contact_fraction,
+        vr::stat_P_contact => m.P_contact,
+        vr::stat_P_lubricant => m.P_lubricant,
+        _ => return None,
+    })
+}
+
+/// An Integer stat_* output from the window's figures; None if `vr` is none of them.
+fn stat_integer(m: &Metrics, vr: u32) -> Option<i64> {
+    let [plus, minus] = &m.flanks;
+    let (regime, side) = m.regime();
+    Some(match vr {
+        vr::stat_impacts_Fplus => plus.impacts as i64,
+        vr::stat_impacts_Fminus => minus.impacts as i64,
+        vr::stat_runs_Fplus => plus.runs as i64,
+        vr::stat_runs_Fminus => minus.runs as i64,
+        vr::stat_run_max_Fplus => plus.run_max as i64,
+        vr::stat_run_max_Fminus => minus.run_max as i64,
+        vr::stat_regime => regime,
+        vr::stat_side => side,
+        _ => return None,
+    })
 }

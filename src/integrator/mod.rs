@@ -107,6 +107,12 @@ pub trait Piecewise<const N: usize>: System<N> {
         false
     }
 
+    /// Called with each accepted step from t0 of length h and its dense output, whole (also
+    /// when it is then redone to end on an edge inside it, or kept past the end time): what
+    /// the system records along its trajectory between the edges (the peak of an output) is
+    /// taken here.
+    fn observe<D: Dense<N>>(&mut self, _t0: f64, _h: f64, _step: &D) {}
+
     /// Moves to the piece that contains `y[GUARD]` through each edge on the way (after a
     /// jump of the state from outside the integrator); returns how many edges were crossed.
     fn settle(&mut self, t: f64, y: &[f64; N]) -> usize {

@@ -554,6 +554,7 @@ impl<const N: usize> Solver<N> {
             return Err(SolverError::StepTooSmall { t: *t, h });
         }
         let step = taylor::Step::new(*c, h);
+        sys.observe(*t, h, &step);
         self.stats.accepted += 1;
         self.stats.series_steps += 1;
         // What DOPRI5 knew of this point and of the piece's entry does not carry over.
@@ -658,7 +659,7 @@ impl<const N: usize> Solver<N> {
     /// leaves its piece through, if any) or rejected with the step size to retry with.
     fn attempt<S: Piecewise<N> + Jacobian<N>>(
         &mut self,
-        sys: &S,
+        sys: &mut S,
         at: Start<N>,
         h: f64,
         trial_buffer: &mut dopri5::Trial<N>,
@@ -671,6 +672,7 @@ impl<const N: usize> Solver<N> {
             if !verdict.accept {
                 return Err(verdict.h_next);
             }
+            sys.observe(at.t, h, &trial);
             Ok(Accepted {
                 y1: trial.y1,
                 explicit: false,
@@ -689,6 +691,7 @@ impl<const N: usize> Solver<N> {
             if !verdict.accept {
                 return Err(verdict.h_next);
             }
+            sys.observe(at.t, h, trial);
             Ok(Accepted {
                 y1: trial.y1,
                 h_next: verdict.h_next,

@@ -22,6 +22,8 @@ pub struct FlightState {
     pub xi_dot: f64,
     /// ∫ C (ω_L − ω_S)² dτ since the start of the flight [J].
     pub e_lubricant: f64,
+    /// ∫ (ω_L − ω_S) dτ since the start of the flight [rad].
+    pub slip_integral: f64,
 }
 
 /// What every point of a free flight from (t0, ξ0, ξ'0) shares: the start, the shaft there
@@ -107,16 +109,20 @@ impl<'a> Flight<'a> {
         let em1 = (-x).exp_m1();
         let phi1 = if p.C == 0.0 { tau } else { -em1 * inv_lambda };
         let mut u = u0 * (1.0 + em1);
-        let mut turned_L = p.omega_S * tau + u0 * phi1;
+        let mut slipped = u0 * phi1;
+        let mut turned_L = p.omega_S * tau + slipped;
         if p.B != 0.0 {
             let beta = p.B / p.I_L;
             u += beta * phi1;
-            turned_L += beta * tau * tau * phi2(x);
+            let drift = beta * tau * tau * phi2(x);
+            turned_L += drift;
+            slipped += drift;
         }
         FlightState {
             xi: xi0 + (p.r_L * turned_L - p.r_M * span.angle),
             xi_dot: p.r_L * (p.omega_S + u) - p.r_M * span.omega1,
             e_lubricant: self.dissipated(tau, phi1, em1),
+            slip_integral: slipped,
         }
     }
 

@@ -13,7 +13,7 @@ pub mod series;
 
 pub use contact::{ContactLaw, ForceSlopes, Region};
 pub use excitation::{Excitation, Polynomial, Shaft, Sine, TorqueRamp};
-pub use flight::{Flight, FlightStart};
+pub use flight::{Flight, FlightStart, FlightState};
 pub use motion::{Dynamics, Loads, MainShaft};
 pub use params::{GearParams, ParamError};
 pub use series::ContactSeries;

@@ -8,14 +8,15 @@
 //!   ξ''  = r_L ω_L' − r_M ω_M',   θ_M' = ω_M
 //!
 //! State: ξ, ξ' and θ_M, ω_M (under error control), then the quadratures of
-//! [`crate::rattle`]: E_contact, E_lubricant and the work W_shaft = ∫ −τ_M ω_M dt the shaft
-//! feeds into the loose gear. The regions, edges and impact counts are those of the
+//! [`crate::rattle::window::quadrature`]: E_contact, E_lubricant, the work
+//! W_shaft = ∫ −τ_M ω_M dt the shaft feeds into the loose gear, ∫a² dt, ∫F dt and ∫F² dt. The regions, edges and impact counts are those of the
 //! kinematic [`Rattle`](super::Rattle).
 #![allow(non_snake_case)]
 
 use serde::{Deserialize, Serialize};
 
-use super::{Impacts, LOCAL_SHARE, contact_pieces, power_flows, scales};
+use super::window::{Window, quadrature};
+use super::{Impacts, LOCAL_SHARE, contact_pieces, quadrature_rates, scales};
 pub use super::{XI, XI_DOT};
 use crate::integrator::{Jacobian, System, Tolerance};
 use crate::physics::{Dynamics, Loads, MainShaft, Region, Shaft, TorqueRamp};
@@ -25,9 +26,12 @@ use crate::physics::{Dynamics, Loads, MainShaft, Region, Shaft, TorqueRamp};
 pub const THETA_M: usize = 2;
 pub const OMEGA_M: usize = 3;
 pub const E_CONTACT: usize = 4;
-pub const E_LUBRICANT: usize = 5;
-pub const W_SHAFT: usize = 6;
-pub const N: usize = 7;
+pub const E_LUBRICANT: usize = E_CONTACT + quadrature::E_LUBRICANT;
+pub const W_SHAFT: usize = E_CONTACT + quadrature::W_SHAFT;
+pub const A2: usize = E_CONTACT + quadrature::A2;
+pub const F1: usize = E_CONTACT + quadrature::F1;
+pub const F2: usize = E_CONTACT + quadrature::F2;
+pub const N: usize = E_CONTACT + quadrature::COUNT;
 
 pub type State = [f64; N];
 
@@ -39,16 +43,21 @@ pub struct TorqueRattle {
     pub region: Region,
     pub torque: TorqueRamp,
     pub impacts: Impacts,
+    pub window: Window,
 }
 
 impl TorqueRattle {
+    /// The pair at ξ, with no statistics window (one opens with
+    /// [`GearPair::with_window`](super::GearPair::with_window)).
     pub fn new(dynamics: Dynamics, main: MainShaft, torque: TorqueRamp, xi: f64) -> Self {
+        let region = dynamics.law.classify(xi);
         TorqueRattle {
-            region: dynamics.law.classify(xi),
+            region,
             dynamics,
             main,
             torque,
             impacts: Impacts::default(),
+            window: Window::closed(region),
         }
     }
 
@@ -59,18 +68,17 @@ impl TorqueRattle {
         let rtol = rtol * LOCAL_SHARE;
         let (xi_scale, xi_dot_scale) = scales(&self.dynamics.params);
         let r_M = self.dynamics.params.r_M;
+        let mut atol = [0.0; N];
+        atol[..E_CONTACT].copy_from_slice(&[
+            rtol * xi_scale,
+            rtol * xi_dot_scale,
+            rtol * xi_scale / r_M,
+            rtol * xi_dot_scale / r_M,
+        ]);
         Tolerance {
             rtol,
-            atol: [
-                rtol * xi_scale,
-                rtol * xi_dot_scale,
-                rtol * xi_scale / r_M,
-                rtol * xi_dot_scale / r_M,
-                0.0,
-                0.0,
-                0.0,
-            ],
-            controlled: 4,
+            atol,
+            controlled: E_CONTACT,
         }
     }
 
@@ -93,17 +101,11 @@ impl System<N> for TorqueRattle {
     #[inline]
     fn rhs(&self, t: f64, y: &State) -> State {
         let (loads, shaft) = self.loads(t, y);
-        let p = &self.dynamics.params;
-        let [e_contact, e_lubricant, w_shaft] = power_flows(p, &loads, y[XI_DOT], shaft.omega);
-        [
-            y[XI_DOT],
-            loads.xi_ddot,
-            shaft.omega,
-            shaft.alpha,
-            e_contact,
-            e_lubricant,
-            w_shaft,
-        ]
+        let q = quadrature_rates(&self.dynamics.params, &loads, y[XI_DOT], shaft.omega);
+        let mut f = [0.0; N];
+        f[..E_CONTACT].copy_from_slice(&[y[XI_DOT], loads.xi_ddot, shaft.omega, shaft.alpha]);
+        f[E_CONTACT..].copy_from_slice(&q);
+        f
     }
 }
 
@@ -112,7 +114,7 @@ impl Jacobian<N> for TorqueRattle {
     /// ([`ContactLaw::slopes`](crate::physics::ContactLaw::slopes)):
     /// ∂ξ''/∂ξ = −k F_ξ, ∂ξ''/∂ξ' = −k F_v − C/I_L, ∂ξ''/∂ω_M = −C r_M/I_L with
     /// k = r_L²/I_L + r_M²/I_M; ∂ω_M'/∂ξ = r_M F_ξ/I_M, ∂ω_M'/∂ξ' = r_M F_v/I_M; θ_M and the
-    /// quadratures enter no right-hand side.
+    /// quadratures enter no right-hand side. The quadratures' rows follow from their rates.
     fn jacobian(&self, t: f64, y: &State) -> [[f64; N]; N] {
         let p = &self.dynamics.params;
         let (xi, xi_dot, omega_M) = (y[XI], y[XI_DOT], y[OMEGA_M]);
@@ -142,6 +144,24 @@ impl Jacobian<N> for TorqueRattle {
         j[W_SHAFT][XI] = -r_M * f.d_xi * omega_M;
         j[W_SHAFT][XI_DOT] = -r_M * f.d_xi_dot * omega_M;
         j[W_SHAFT][OMEGA_M] = -r_M * force;
+        // (∫a²)' = a², a = r_L α_L = (r_L/I_L)(B − r_L F − C (ω_L − ω_S))
+        let a = r_L * loads.alpha_L;
+        let lever = r_L / p.I_L;
+        let da = [
+            -lever * r_L * f.d_xi,
+            -lever * (r_L * f.d_xi_dot + p.C / r_L),
+            -lever * p.C * r_M / r_L,
+        ];
+        // (∫F)' = F and (∫F²)' = F²
+        let df = [f.d_xi, f.d_xi_dot, 0.0];
+        for (col, (da, df)) in [XI, XI_DOT, OMEGA_M]
+            .into_iter()
+            .zip(da.into_iter().zip(df))
+        {
+            j[A2][col] = 2.0 * a * da;
+            j[F1][col] = df;
+            j[F2][col] = 2.0 * force * df;
+        }
         j
     }
 }
@@ -179,9 +199,9 @@ mod tests {
             let g = params.G;
             for xi in [-3e-6, -0.6e-6, 10e-6, g + 0.3e-6, g + 4e-6] {
                 let sys = TorqueRattle::new(Dynamics::new(params), main, torque, xi);
-                let (t, y) = (0.0123, [xi, 0.013, 4.5, 83.0, 0.1, 0.2, 0.3]);
+                let (t, y) = (0.0123, [xi, 0.013, 4.5, 83.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6]);
                 let j = sys.jacobian(t, &y);
-                let scale = [1e-12, 1e-8, 1e-6, 1e-6, 1e-3, 1e-3, 1e-3];
+                let scale = [1e-12, 1e-8, 1e-6, 1e-6, 1e-3, 1e-3, 1e-3, 1e-3, 1e-3, 1e-3];
                 for col in 0..N {
                     let (mut up, mut down) = (y, y);
                     up[col] += scale[col];
@@ -213,7 +233,8 @@ mod tests {
             rate: 0.0,
         };
         let sys = TorqueRattle::new(Dynamics::new(params), main, torque, -2e-6);
-        let y = [-2e-6, 0.01, 1.0, 50.0, 0.0, 0.0, 0.0];
+        let mut y = [0.0; N];
+        y[..4].copy_from_slice(&[-2e-6, 0.01, 1.0, 50.0]);
         let f = sys.rhs(0.0, &y);
         assert_eq!(f[THETA_M], 50.0);
         assert!((f[OMEGA_M] - 300.0).abs() < 1e-6);
