@@ -120,12 +120,9 @@ pub trait GearPair<const N: usize>: Piecewise<N> {
 }
 
 /// Share of the requested tolerance given to each step's local error. The request is read as
-/// a bound on the error after a few impacts, and the local errors of the steps add up: on the
-/// 37 stress cases (tests/python/stress_cases.py, rtol 1e-8, windows of two impacts) the whole
-/// request per step left two cases above 10 × rtol (K* = 1e8 at 14, the energy of free
-/// rattling at 18), half of it two others (ε = 1e-12 at 17, the energy at 20), while shares of
-/// 0.35, 0.25, 0.18 and 0.125 kept all 37 within; 0.25 sits inside that range. It costs
-/// 4^(1/5) = 1.32 times the steps at a given request, not at a given error.
+/// a bound on the error after a few impacts, and the local errors of the steps add up over a
+/// contact; with this share all 37 stress cases stay within 10 × rtol (docs/DECISIONS.md,
+/// D21). It costs 4^(1/5) = 1.32 times the steps at a given request, not at a given error.
 pub(crate) const LOCAL_SHARE: f64 = 0.25;
 
 /// Scales of ξ and ξ' for the error weights (see [`Rattle::tolerance`]).

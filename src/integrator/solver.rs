@@ -93,14 +93,10 @@ impl std::fmt::Display for SolverError {
 /// The first DOPRI5 step into a piece that is rough at its start ([`Piecewise::rough_start`])
 /// is accepted at 1/20 of the tolerance. Where a force law starts at the edge as a
 /// non-integer power (contact without a smoothing band, F ∝ δ^α), the solution is not smooth
-/// at the step's start and DOPRI5's embedded estimate understates the error: for
-/// x'' = −τ^α from τ = 0 the true error of one step is 6.3 to 20 times the estimate for α
-/// from 1.001 to 1.99 (computed with DOPRI5's coefficients; exact at α = 1 and 2; at most 3.3
-/// for α = 2.5, an overestimate from α = 3.5 on). Measured on the stress suite at rtol 1e-8:
-/// ε = 0 from 46 rtol to 1.9 for 1.4 % more right-hand sides. The steps after the first
-/// start inside the piece, where the estimate holds again. Applied to every crossing, the
-/// same factor changed S2's error over 50 ms from 14 to 101 rtol at rtol 1e-6 (steps grow
-/// faster after a small one), so it is kept to where the estimate is known to fail.
+/// at the step's start and DOPRI5's embedded estimate understates that step's error (6 to 20
+/// times for x'' = −τ^α, α in (1, 2)). The steps after the first start inside the piece,
+/// where the estimate holds again; applied at every crossing the factor only moves errors
+/// around (docs/DECISIONS.md, D6).
 const FIRST_STEP_DISTRUST: f64 = 20.0;
 
 /// Edge crossings allowed at one instant before the solver gives up.
