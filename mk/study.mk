@@ -28,8 +28,7 @@ study-examples: fmu $(VENV)/.installed
 		$(VENV)/bin/gearrattle-study run examples/studies/$$s.toml --quiet; \
 		cp target/studies/$$s/summary.txt docs/studies/$$s.txt; \
 	done
-	cp target/studies/map_paper/map_stat_run_mean_Fplus.png docs/studies/map_run_mean_Fplus.png
-	cp target/studies/map_paper/map_stat_rattle_power.png docs/studies/map_rattle_power.png
+	cp target/studies/map_paper/map_overview.png docs/studies/map_paper.png
 	cp target/studies/mc_idle/mc_distributions.png docs/studies/mc_idle.png
 	cp target/studies/sobol_s1/mc_sensitivity.png docs/studies/sobol_s1.png
-	cp target/studies/doe_backlash_drag/doe_stat_rattle_power.png docs/studies/doe_rattle_power.png
+	cp target/studies/doe_backlash_drag/doe_G.png docs/studies/doe_backlash_drag.png

@@ -9,6 +9,7 @@ import os
 import numpy as np
 
 from . import designs
+from .figures import panels, save
 from .report import column, ok_rows
 
 PERCENTILES = (1, 5, 25, 50, 75, 95, 99)
@@ -38,7 +39,8 @@ def exceedance(k, n, confidence=CONFIDENCE):
     return k / n, ci.low, ci.high
 
 
-def analyse(st, table, metrics):
+def analyse(st, table, metrics, drawn):
+    """Summary lines and files; every metric in the CSVs, those in drawn in the figures."""
     ok = ok_rows(table)
     lines, files, pct_rows, exc_rows, sens_rows = [], [], [], [], []
     for label, mask in _operating_points(st, table):
@@ -63,18 +65,20 @@ def analyse(st, table, metrics):
             more, rows = _sensitivity(st, table, mask, metrics, label)
             lines += more
             sens_rows += rows
-        files.append(_figure(st, table, sel, metrics, label, len(files)))
+        files.append(_figure(st, table, sel, drawn, label, len(files)))
     files.append(_csv(st.out, "percentiles.csv", ["operating_point", "metric", "n", "mean", "sd"]
                       + [f"p{p}" for p in PERCENTILES], pct_rows))
     if exc_rows:
         files.append(_csv(st.out, "exceedance.csv", ["operating_point", "event", "k", "n", "p",
                                                      "ci_low", "ci_high"], exc_rows))
+    drawn_rows = [r for r in sens_rows if r[1] in drawn]
     if sens_rows:
         cols = (["operating_point", "metric", "parameter", "S1", "S1_conf", "ST", "ST_conf"]
                 if st.sensitivity == "sobol" else
                 ["operating_point", "metric", "parameter", "mu_star", "mu_star_conf", "sigma"])
         files.append(_csv(st.out, "sensitivity.csv", cols, sens_rows))
-        files.append(_sensitivity_figure(st, sens_rows))
+        if drawn_rows:
+            files.append(_sensitivity_figure(st, drawn_rows))
     return lines, files
 
 
@@ -119,23 +123,10 @@ def _csv(out, name, header, rows):
     return path
 
 
-def _plt():
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
-
-
 def _figure(st, table, sel, metrics, label, k):
     """Histogram and ECDF of each metric: mc_distributions[_k].png."""
-    plt = _plt()
-    cols = 4
-    rows = -(-len(metrics) // cols)
-    fig, axes = plt.subplots(rows, cols, figsize=(4 * cols, 2.8 * rows), squeeze=False,
-                             constrained_layout=True)
-    for ax, m in zip(axes.flat, metrics):
+    plt, fig, axes = panels(len(metrics))
+    for ax, m in zip(axes, metrics):
         x = column(table, m)[sel]
         x = np.sort(x[np.isfinite(x)])
         ax.hist(x, bins=min(40, max(5, len(x) // 20)), color="tab:blue", alpha=0.6)
@@ -148,29 +139,21 @@ def _figure(st, table, sel, metrics, label, k):
         for ex in st.exceed:
             if ex.metric == m:
                 ax.axvline(ex.value, color="tab:red", ls="--", lw=1)
-    for ax in list(axes.flat)[len(metrics):]:
-        ax.axis("off")
     dists = "; ".join(str(d) for d in st.dists)
     fig.suptitle(f"Monte Carlo{' at ' + label if label else ''}: {int(sel.sum())} gearboxes "
                  f"({dists}); bars histogram, line ECDF, dashed thresholds", fontsize=9)
-    path = os.path.join(st.out, f"mc_distributions{'_' + str(k) if k else ''}.png")
-    fig.savefig(path, dpi=90)
-    plt.close(fig)
-    return path
+    name = f"mc_distributions{'_' + str(k) if k else ''}.png"
+    return save(plt, fig, os.path.join(st.out, name))
 
 
 def _sensitivity_figure(st, rows):
     """Bars of the indices (S1 and ST, or mu*) per parameter for each metric and operating
     point: mc_sensitivity.png."""
-    plt = _plt()
     keys = sorted({(r[0], r[1]) for r in rows})
     names = [d.name for d in st.dists]
-    cols = 4
-    nrow = -(-len(keys) // cols)
-    fig, axes = plt.subplots(nrow, cols, figsize=(4 * cols, 2.6 * nrow), squeeze=False,
-                             constrained_layout=True)
+    plt, fig, axes = panels(len(keys))
     x = np.arange(len(names))
-    for ax, key in zip(axes.flat, keys):
+    for ax, key in zip(axes, keys):
         sel = {r[2]: r for r in rows if (r[0], r[1]) == key}
         if st.sensitivity == "sobol":
             ax.bar(x - 0.2, [sel[n][3] for n in names], 0.4, yerr=[sel[n][4] for n in names],
@@ -184,12 +167,7 @@ def _sensitivity_figure(st, rows):
         ax.set_xticklabels(names, fontsize=7)
         ax.set_title(f"{key[1]}" + (f" at {key[0]}" if key[0] else ""), fontsize=8)
         ax.tick_params(labelsize=7)
-    axes.flat[0].legend(fontsize=7)
-    for ax in list(axes.flat)[len(keys):]:
-        ax.axis("off")
+    axes[0].legend(fontsize=7)
     fig.suptitle(f"{'Sobol' if st.sensitivity == 'sobol' else 'Morris'} indices "
                  f"({st.n} base samples)", fontsize=9)
-    path = os.path.join(st.out, "mc_sensitivity.png")
-    fig.savefig(path, dpi=90)
-    plt.close(fig)
-    return path
+    return save(plt, fig, os.path.join(st.out, "mc_sensitivity.png"))

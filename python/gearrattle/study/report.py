@@ -7,6 +7,18 @@ import os
 import numpy as np
 
 
+# The metrics drawn in the overview figures (all of them are in points.csv): where a user of a
+# rattle map looks first. An FMU without them gets its first metrics drawn.
+FIGURE_METRICS = ["stat_impact_rate_Fplus", "stat_impact_rate_Fminus", "stat_run_mean_Fplus",
+                  "stat_run_max_Fplus", "stat_v_mean_Fplus", "stat_rattle_power", "stat_a_rms",
+                  "stat_regime"]
+
+
+def figure_metrics(metrics, record):
+    drawn = [m for m in FIGURE_METRICS if m in metrics]
+    return (drawn or [m for m in metrics if m not in record][:len(FIGURE_METRICS)]) + list(record)
+
+
 def ok_rows(table):
     return np.asarray(table.column("status").to_pylist()) == "ok"
 
@@ -45,12 +57,13 @@ def write(st, model, table, wall):
             x = x[np.isfinite(x)]
             lines.append(f"  {m:24s} " + (f"{x.min():11.4g} {np.median(x):11.4g} {x.max():11.4g}"
                                           if len(x) else "undefined at every point"))
+    drawn = figure_metrics(metrics, st.record)
     if st.kind == "map" and metrics:
-        files += figures.map_figures(st, table, metrics)
+        files += figures.map_figures(st, table, drawn)
     elif st.kind == "doe" and metrics:
-        files += figures.doe_figures(st, table, metrics)
+        files += figures.doe_figures(st, table, drawn)
     elif st.kind == "mc" and metrics:
-        more, extra = montecarlo.analyse(st, table, metrics)
+        more, extra = montecarlo.analyse(st, table, metrics, drawn)
         lines += more
         files += extra
     path = os.path.join(st.out, "summary.txt")
