@@ -10,15 +10,16 @@
 //! - [`rattle`]: the gear pair as a piecewise ODE for the integrator, with impact counting
 //!   (the shaft's motion imposed; [`rattle::torque`]: driven by a torque, 7 states);
 //! - [`instance`]: the co-simulation slave (FMI state machine, variables, stepping);
-//! - [`ffi`]: the `fmi2*` C exports on fmi-sys types, one guard around each;
+//! - the `fmi2*` C exports: [`fmi2_shell`]'s, around [`instance::Instance`];
 //! - [`contract`]: value references and the model description, generated from
 //!   `modelDescription/GearRattle.toml`.
 
 pub mod contract;
-pub mod ffi;
 pub mod instance;
 pub mod integrator;
 pub mod math;
 pub mod packaging;
 pub mod physics;
 pub mod rattle;
+
+fmi2_shell::export_co_simulation!(crate::instance::Instance);

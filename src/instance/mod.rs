@@ -1,37 +1,26 @@
-//! The co-simulation slave: FMI 2.0's calls as methods on a typed instance, free of C types.
-//! Each method returns `Ok(status)` or an [`FmiError`] with its reason; the C layer turns
-//! them into fmi2Status and log lines. Which calls are allowed in which state is in
-//! [`state::allowed`]; the C layer checks it before calling in.
+//! The co-simulation slave: FMI 2.0's calls as methods on a typed instance, free of C types,
+//! for the shell ([`fmi2_shell::Slave`]). Each method returns `Ok(())` or an [`FmiError`]
+//! with its reason; the shell checks the state machine before calling in and turns the
+//! results into fmi2Status and log lines.
 
-pub mod error;
-pub mod fmu_state;
 pub mod simulation;
-pub mod state;
 pub mod values;
 
-pub use error::{FmiError, FmiResult, Status};
+pub use fmi2_shell::{FmiError, FmiResult, FmiState, Status};
 pub use simulation::Simulation;
-pub use state::FmiState;
 
 use crate::contract::{self, Causality, Kind, LOG_CATEGORIES, vr};
 use crate::physics::Shaft;
 use crate::rattle::Impacts;
+use fmi2_shell::{Identity, Log, Slave};
 use serde::{Deserialize, Serialize};
 use values::Values;
 
-/// A line for the importer's logger.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Message {
-    pub status: Status,
-    pub category: &'static str,
-    pub text: String,
-}
-
-/// The contract's log categories by role.
-const ERRORS: usize = contract::log::logStatusError;
-const WARNINGS: usize = contract::log::logStatusWarning;
+/// The contract's log categories by role (errors and warnings first, as the shell wants).
 const EVENTS: usize = contract::log::logEvents;
 const STEPS: usize = contract::log::logStep;
+const _: () = assert!(contract::log::logStatusError == fmi2_shell::log::ERRORS);
+const _: () = assert!(contract::log::logStatusWarning == fmi2_shell::log::WARNINGS);
 
 /// One co-simulation instance. Everything but the logging settings and the queued lines is
 /// its FMU state (fmi2GetFMUstate / fmi2SerializeFMUstate): parameters, inputs, time, the
@@ -46,12 +35,9 @@ pub struct Instance {
     /// initialisation, from the values set so far).
     sim: Option<Simulation>,
     last_successful_time: f64,
-    /// Log categories switched on, in the order of `LOG_CATEGORIES`.
+    /// Log categories switched on and lines waiting for the importer's logger.
     #[serde(skip)]
-    logging: [bool; LOG_CATEGORIES.len()],
-    /// Lines waiting for the importer's logger.
-    #[serde(skip)]
-    pub messages: Vec<Message>,
+    log: Log,
 }
 
 /// Why fmi2DoStep refuses a step ([`Instance::check_step`]).
@@ -66,132 +52,14 @@ enum StepRefusal {
 }
 
 impl Instance {
-    pub fn new(logging_on: bool) -> Self {
-        let mut logging = [logging_on; LOG_CATEGORIES.len()];
-        logging[ERRORS] = true;
-        logging[WARNINGS] = true;
-        Instance {
-            state: FmiState::Instantiated,
-            values: Values::start(),
-            start_time: 0.0,
-            tolerance: None,
-            sim: None,
-            last_successful_time: 0.0,
-            logging,
-            messages: Vec::new(),
-        }
-    }
-
-    /// Queues a line for the logger if its category is on (errors always are).
-    pub fn log(&mut self, status: Status, category: usize, text: impl FnOnce() -> String) {
-        if self.logging[category] {
-            self.messages.push(Message {
-                status,
-                category: LOG_CATEGORIES[category].0,
-                text: text(),
-            });
-        }
-    }
-
-    /// Queues the reason of a refused or failed call.
-    pub fn log_error(&mut self, error: &FmiError) {
-        let category = if error.status <= Status::Warning {
-            WARNINGS
-        } else {
-            ERRORS
-        };
-        self.log(error.status, category, || error.message.clone());
-    }
-
-    pub fn set_debug_logging(&mut self, on: bool, categories: &[String]) -> FmiResult {
-        let mut indices = Vec::with_capacity(categories.len());
-        for name in categories {
-            match LOG_CATEGORIES.iter().position(|(c, _)| c == name) {
-                Some(i) => indices.push(i),
-                None => {
-                    let declared: Vec<_> = LOG_CATEGORIES.iter().map(|(c, _)| *c).collect();
-                    return Err(FmiError::error(format!(
-                        "unknown log category \"{name}\"; declared: {}",
-                        declared.join(", ")
-                    )));
-                }
-            }
-        }
-        if indices.is_empty() {
-            indices.extend(0..LOG_CATEGORIES.len());
-        }
-        for i in indices {
-            // Errors are always reported: a refused call must say why.
-            self.logging[i] = on || i == ERRORS;
-        }
-        Ok(())
-    }
-
-    pub fn setup_experiment(&mut self, tolerance: Option<f64>, start_time: f64) -> FmiResult {
-        if !start_time.is_finite() {
-            return Err(FmiError::error(format!(
-                "startTime = {start_time} must be finite"
-            )));
-        }
-        if let Some(tol) = tolerance
-            && !(tol > 0.0 && tol < 1.0)
-        {
-            return Err(FmiError::error(format!(
-                "tolerance = {tol:e} must lie in (0, 1)"
-            )));
-        }
-        self.start_time = start_time;
-        self.tolerance = tolerance;
-        Ok(())
-    }
-
-    pub fn enter_initialization_mode(&mut self) -> FmiResult {
-        self.state = FmiState::InitializationMode;
-        self.sim = None;
-        Ok(())
+    /// Queues a line for the logger if its category is on.
+    fn log_line(&mut self, status: Status, category: usize, text: impl FnOnce() -> String) {
+        self.log.log(status, category, text);
     }
 
     fn build(&self) -> FmiResult<Simulation> {
         let rtol = self.tolerance.unwrap_or(contract::DEFAULT_TOLERANCE);
         Simulation::new(&self.values, self.start_time, rtol)
-    }
-
-    /// Validates every parameter and builds the initial state; an invalid parameter is
-    /// refused and the instance stays in initialisation mode, where it can be corrected.
-    pub fn exit_initialization_mode(&mut self) -> FmiResult {
-        let sim = self.build()?;
-        self.sim = Some(sim);
-        self.last_successful_time = self.start_time;
-        self.state = FmiState::StepComplete;
-        Ok(())
-    }
-
-    pub fn terminate(&mut self) -> FmiResult {
-        self.state = FmiState::Terminated;
-        Ok(())
-    }
-
-    /// Back to the state after instantiation: start values, no time, no counters.
-    pub fn reset(&mut self) -> FmiResult {
-        self.restore(&Instance::new(false));
-        Ok(())
-    }
-
-    /// A copy of the FMU state (no log lines).
-    pub fn snapshot(&self) -> Instance {
-        Instance {
-            messages: Vec::new(),
-            ..self.clone()
-        }
-    }
-
-    /// Takes over a saved FMU state, keeping this instance's logging settings and lines.
-    pub fn restore(&mut self, saved: &Instance) {
-        *self = Instance {
-            logging: self.logging,
-            messages: std::mem::take(&mut self.messages),
-            ..saved.clone()
-        };
     }
 
     /// The running simulation, or during initialisation one built from the values so far.
@@ -208,17 +76,6 @@ impl Instance {
         })
     }
 
-    pub fn get_real(&mut self, vrs: &[u32], out: &mut [f64]) -> FmiResult {
-        for (vr, out) in vrs.iter().zip(out) {
-            // An output of the running simulation first: what a master reads after each step.
-            *out = match self.sim.as_ref().and_then(|sim| sim.real_output(*vr)) {
-                Some(value) => value,
-                None => self.real_value(*vr)?,
-            };
-        }
-        Ok(())
-    }
-
     /// A Real variable's value by its contract entry (a parameter, an input, or an output of
     /// the simulation built from the values so far).
     fn real_value(&mut self, vr: u32) -> FmiResult<f64> {
@@ -229,21 +86,6 @@ impl Instance {
                 .expect("every Real output of the contract is computed"),
             _ => self.values.real(vr),
         })
-    }
-
-    pub fn get_integer(&mut self, vrs: &[u32], out: &mut [i32]) -> FmiResult {
-        for (vr, out) in vrs.iter().zip(out) {
-            let var = Self::variable(Kind::Integer, *vr)?;
-            let value = match var.causality {
-                Causality::Output => self
-                    .current()?
-                    .integer_output(*vr)
-                    .expect("every Integer output of the contract is computed"),
-                _ => self.values.integer(*vr),
-            };
-            *out = i32::try_from(value).unwrap_or(i32::MAX);
-        }
-        Ok(())
     }
 
     /// Checks that `var` may be set now.
@@ -263,30 +105,6 @@ impl Instance {
         }
     }
 
-    /// Sets Real parameters or inputs. The whole call is checked first, so a refused call
-    /// changes nothing.
-    pub fn set_real(&mut self, vrs: &[u32], values: &[f64]) -> FmiResult {
-        for (vr, value) in vrs.iter().zip(values) {
-            let var = Self::variable(Kind::Real, *vr)?;
-            self.settable(var)?;
-            if !value.is_finite() {
-                return Err(FmiError::error(format!(
-                    "{} = {value} refused: values must be finite",
-                    var.name
-                )));
-            }
-        }
-        let mut shaft_changed = false;
-        for (vr, value) in vrs.iter().zip(values) {
-            self.values.set_real(*vr, *value);
-            shaft_changed |= matches!(*vr, vr::theta_M | vr::omega_M | vr::alpha_M | vr::tau_in);
-        }
-        if shaft_changed || self.state != FmiState::StepComplete {
-            self.inputs_changed();
-        }
-        Ok(())
-    }
-
     /// After new values: rebuild the initial state during initialisation, or hand the main
     /// shaft's new motion (inputs mode) or torque (torque mode) to the running simulation
     /// (inputs take effect at once).
@@ -304,7 +122,7 @@ impl Instance {
                 sim.set_shaft(shaft);
                 sim.set_torque(tau, rate);
                 if before != sim.impacts() {
-                    self.log(Status::Ok, EVENTS, || {
+                    self.log_line(Status::Ok, EVENTS, || {
                         "new inputs moved the gear pair across a contact onset".to_string()
                     });
                 }
@@ -314,131 +132,7 @@ impl Instance {
         }
     }
 
-    /// fmi2SetRealInputDerivatives: the derivatives of θ_M (orders 1, 2) and ω_M (order 1) at
-    /// the start of the next step set the speed and acceleration of the main shaft's Taylor
-    /// polynomial over the step (a later call for the same quantity wins); the derivative of
-    /// τ_in (order 1) ramps the torque over the step (torque mode). Like the inputs, a
-    /// derivative holds until it is set again.
-    pub fn set_input_derivatives(
-        &mut self,
-        vrs: &[u32],
-        orders: &[i32],
-        values: &[f64],
-    ) -> FmiResult {
-        let mut targets = Vec::with_capacity(vrs.len());
-        for ((vr, order), value) in vrs.iter().zip(orders).zip(values) {
-            // Where the derivative is kept: an input variable, or τ_in's rate (None).
-            let target = match (*vr, *order) {
-                (vr::theta_M, 1) => Some(vr::omega_M),
-                (vr::theta_M, 2) | (vr::omega_M, 1) => Some(vr::alpha_M),
-                (vr::tau_in, 1) => None,
-                _ => {
-                    let name = contract::find(Kind::Real, *vr).map_or("?", |v| v.name);
-                    return Err(FmiError::error(format!(
-                        "derivative of order {order} of value reference {vr} ({name}) is not an input derivative of this model: theta_M takes orders 1 and 2, omega_M and tau_in order 1"
-                    )));
-                }
-            };
-            if !value.is_finite() {
-                return Err(FmiError::error(format!(
-                    "derivative {value} of order {order} refused: values must be finite"
-                )));
-            }
-            targets.push((target, *value));
-        }
-        for (target, value) in targets {
-            match target {
-                Some(vr) => self.values.set_real(vr, value),
-                None => self.values.set_tau_in_rate(value),
-            }
-        }
-        self.inputs_changed();
-        Ok(())
-    }
-
-    /// fmi2GetRealOutputDerivatives (order 1).
-    pub fn get_output_derivatives(
-        &mut self,
-        vrs: &[u32],
-        orders: &[i32],
-        out: &mut [f64],
-    ) -> FmiResult {
-        let sim = self.current()?;
-        for ((vr, order), out) in vrs.iter().zip(orders).zip(out) {
-            let var = Self::variable(Kind::Real, *vr)?;
-            *out = match (order, sim.real_output_derivative(*vr)) {
-                (1, Some(d)) => d,
-                _ => {
-                    return Err(FmiError::error(format!(
-                        "no derivative of order {order} for {}: order 1 is given for {}",
-                        var.name,
-                        contract::with_derivative().collect::<Vec<_>>().join(", ")
-                    )));
-                }
-            };
-        }
-        Ok(())
-    }
-
-    /// fmi2GetDirectionalDerivative: dv_unknown = J · dv_known with J = ∂outputs/∂inputs.
-    pub fn directional_derivative(
-        &mut self,
-        unknowns: &[u32],
-        knowns: &[u32],
-        dv_known: &[f64],
-        dv_unknown: &mut [f64],
-    ) -> FmiResult {
-        for k in knowns {
-            let var = Self::variable(Kind::Real, *k)?;
-            if var.causality != Causality::Input {
-                return Err(FmiError::error(format!(
-                    "{} is not an input: directional derivatives are taken with respect to theta_M, omega_M, alpha_M, tau_in",
-                    var.name
-                )));
-            }
-        }
-        let sim = self.current()?;
-        for (u, out) in unknowns.iter().zip(dv_unknown) {
-            let var = Self::variable(Kind::Real, *u)?;
-            if var.causality != Causality::Output {
-                return Err(FmiError::error(format!(
-                    "{} is not an output: directional derivatives are of outputs",
-                    var.name
-                )));
-            }
-            *out = knowns
-                .iter()
-                .zip(dv_known)
-                .map(|(k, dv)| sim.partial(*u, *k) * dv)
-                .sum();
-        }
-        Ok(())
-    }
-
-    pub fn set_integer(&mut self, vrs: &[u32], values: &[i32]) -> FmiResult {
-        for vr in vrs {
-            let var = Self::variable(Kind::Integer, *vr)?;
-            self.settable(var)?;
-        }
-        for (vr, value) in vrs.iter().zip(values) {
-            self.values.set_integer(*vr, *value as i64);
-        }
-        if self.state == FmiState::InitializationMode {
-            self.sim = None;
-        }
-        Ok(())
-    }
-
     /// Refuses any value reference: the model has no Boolean or String variables.
-    pub fn no_variables_of(kind: &str, vrs: &[u32]) -> FmiResult {
-        match vrs.first() {
-            Some(vr) => Err(FmiError::error(format!(
-                "unknown value reference {vr} for type {kind}: the model has no {kind} variables"
-            ))),
-            None => Ok(()),
-        }
-    }
-
     /// Main inputs coherent with the previous values: `theta_M` and `omega_M` (inputs mode)
     /// or `tau_in` (torque mode) follow the extrapolation when the master does not set them
     /// again (see `Simulation::step_to`).
@@ -450,36 +144,6 @@ impl Instance {
             }
             Some(simulation::Drive::Torque { tau, .. }) => self.values.set_real(vr::tau_in, tau),
             _ => {}
-        }
-    }
-
-    pub fn do_step(&mut self, current: f64, h: f64) -> FmiResult {
-        let sim = self.sim.as_mut().expect("initialised");
-        if let Err(why) = Self::check_step(current, h, sim.t) {
-            return Err(Self::step_refused(why, current, h, sim.t));
-        }
-        sim.t = current;
-        let t_end = current + h;
-        // What the event log compares with, taken only when that log is on.
-        let before = self.logging[EVENTS].then(|| (sim.impacts(), sim.stats().switches));
-        match sim.step_to(t_end) {
-            Ok(()) => {
-                self.last_successful_time = t_end;
-                self.sync_inputs();
-                if let Some(before) = before {
-                    self.log_events(t_end, before);
-                }
-                if self.logging[STEPS] {
-                    self.log_steps(t_end);
-                }
-                Ok(())
-            }
-            Err(e) => {
-                self.state = FmiState::Error;
-                Err(FmiError::error(format!(
-                    "fmi2DoStep from t = {current} to {t_end} failed: {e}; the state stays at t = {current}"
-                )))
-            }
         }
     }
 
@@ -541,7 +205,7 @@ impl Instance {
             impacts.count[1] - impacts_before.count[1],
         ];
         if new != [0, 0] {
-            self.log(Status::Ok, EVENTS, || {
+            self.log_line(Status::Ok, EVENTS, || {
                 format!(
                     "t = {t_end}: {} impact(s) on F+, {} on F-, last at |xi'| = {:e} m/s",
                     new[0], new[1], impacts.last_speed
@@ -549,7 +213,7 @@ impl Instance {
             });
         }
         if switched {
-            self.log(Status::Ok, EVENTS, || {
+            self.log_line(Status::Ok, EVENTS, || {
                 format!("t = {t_end}: integration method handed over, now {method}")
             });
         }
@@ -559,7 +223,7 @@ impl Instance {
     fn log_steps(&mut self, t_end: f64) {
         let sim = self.simulation();
         let (stats, h_next, method) = (sim.stats(), sim.proposed_step(), Self::method_name(sim));
-        self.log(Status::Ok, STEPS, || {
+        self.log_line(Status::Ok, STEPS, || {
             format!(
                 "t = {t_end}: {} accepted ({} by Radau IIA), {} rejected steps, {} edges, {} rhs evaluations, {} Jacobians, {} LU in total; next step {:e} s by {method}",
                 stats.accepted,
@@ -573,9 +237,313 @@ impl Instance {
             )
         });
     }
+}
+
+impl Slave for Instance {
+    const IDENTITY: Identity = Identity {
+        guid: contract::GUID,
+        model_identifier: contract::MODEL_IDENTIFIER,
+        log_categories: LOG_CATEGORIES,
+        state_magic: *b"GRFS",
+        state_version: 6,
+    };
+
+    fn log(&mut self) -> &mut Log {
+        &mut self.log
+    }
+
+    fn state(&self) -> FmiState {
+        self.state
+    }
+
+    fn set_state(&mut self, state: FmiState) {
+        self.state = state;
+    }
+
+    fn new(logging_on: bool) -> Self {
+        Instance {
+            state: FmiState::Instantiated,
+            values: Values::start(),
+            start_time: 0.0,
+            tolerance: None,
+            sim: None,
+            last_successful_time: 0.0,
+            log: Log::new(LOG_CATEGORIES, logging_on),
+        }
+    }
+
+    fn setup_experiment(&mut self, tolerance: Option<f64>, start_time: f64) -> FmiResult {
+        if !start_time.is_finite() {
+            return Err(FmiError::error(format!(
+                "startTime = {start_time} must be finite"
+            )));
+        }
+        if let Some(tol) = tolerance
+            && !(tol > 0.0 && tol < 1.0)
+        {
+            return Err(FmiError::error(format!(
+                "tolerance = {tol:e} must lie in (0, 1)"
+            )));
+        }
+        self.start_time = start_time;
+        self.tolerance = tolerance;
+        Ok(())
+    }
+
+    fn enter_initialization_mode(&mut self) -> FmiResult {
+        self.state = FmiState::InitializationMode;
+        self.sim = None;
+        Ok(())
+    }
+
+    /// Validates every parameter and builds the initial state; an invalid parameter is
+    /// refused and the instance stays in initialisation mode, where it can be corrected.
+    fn exit_initialization_mode(&mut self) -> FmiResult {
+        let sim = self.build()?;
+        self.sim = Some(sim);
+        self.last_successful_time = self.start_time;
+        self.state = FmiState::StepComplete;
+        Ok(())
+    }
+
+    fn terminate(&mut self) -> FmiResult {
+        self.state = FmiState::Terminated;
+        Ok(())
+    }
+
+    fn get_real(&mut self, vrs: &[u32], out: &mut [f64]) -> FmiResult {
+        for (vr, out) in vrs.iter().zip(out) {
+            // An output of the running simulation first: what a master reads after each step.
+            *out = match self.sim.as_ref().and_then(|sim| sim.real_output(*vr)) {
+                Some(value) => value,
+                None => self.real_value(*vr)?,
+            };
+        }
+        Ok(())
+    }
+
+    fn get_integer(&mut self, vrs: &[u32], out: &mut [i32]) -> FmiResult {
+        for (vr, out) in vrs.iter().zip(out) {
+            let var = Self::variable(Kind::Integer, *vr)?;
+            let value = match var.causality {
+                Causality::Output => self
+                    .current()?
+                    .integer_output(*vr)
+                    .expect("every Integer output of the contract is computed"),
+                _ => self.values.integer(*vr),
+            };
+            *out = i32::try_from(value).unwrap_or(i32::MAX);
+        }
+        Ok(())
+    }
+
+    /// Sets Real parameters or inputs. The whole call is checked first, so a refused call
+    /// changes nothing.
+    fn set_real(&mut self, vrs: &[u32], values: &[f64]) -> FmiResult {
+        for (vr, value) in vrs.iter().zip(values) {
+            let var = Self::variable(Kind::Real, *vr)?;
+            self.settable(var)?;
+            if !value.is_finite() {
+                return Err(FmiError::error(format!(
+                    "{} = {value} refused: values must be finite",
+                    var.name
+                )));
+            }
+        }
+        let mut shaft_changed = false;
+        for (vr, value) in vrs.iter().zip(values) {
+            self.values.set_real(*vr, *value);
+            shaft_changed |= matches!(*vr, vr::theta_M | vr::omega_M | vr::alpha_M | vr::tau_in);
+        }
+        if shaft_changed || self.state != FmiState::StepComplete {
+            self.inputs_changed();
+        }
+        Ok(())
+    }
+
+    fn set_integer(&mut self, vrs: &[u32], values: &[i32]) -> FmiResult {
+        for vr in vrs {
+            let var = Self::variable(Kind::Integer, *vr)?;
+            self.settable(var)?;
+        }
+        for (vr, value) in vrs.iter().zip(values) {
+            self.values.set_integer(*vr, *value as i64);
+        }
+        if self.state == FmiState::InitializationMode {
+            self.sim = None;
+        }
+        Ok(())
+    }
+
+    fn do_step(&mut self, current: f64, h: f64) -> FmiResult {
+        let sim = self.sim.as_mut().expect("initialised");
+        if let Err(why) = Self::check_step(current, h, sim.t) {
+            return Err(Self::step_refused(why, current, h, sim.t));
+        }
+        sim.t = current;
+        let t_end = current + h;
+        // What the event log compares with, taken only when that log is on.
+        let before = self
+            .log
+            .is_on(EVENTS)
+            .then(|| (sim.impacts(), sim.stats().switches));
+        match sim.step_to(t_end) {
+            Ok(()) => {
+                self.last_successful_time = t_end;
+                self.sync_inputs();
+                if let Some(before) = before {
+                    self.log_events(t_end, before);
+                }
+                if self.log.is_on(STEPS) {
+                    self.log_steps(t_end);
+                }
+                Ok(())
+            }
+            Err(e) => {
+                self.state = FmiState::Error;
+                Err(FmiError::error(format!(
+                    "fmi2DoStep from t = {current} to {t_end} failed: {e}; the state stays at t = {current}"
+                )))
+            }
+        }
+    }
 
     /// fmi2LastSuccessfulTime.
-    pub fn last_successful_time(&self) -> f64 {
+    fn last_successful_time(&self) -> f64 {
         self.last_successful_time
+    }
+
+    /// fmi2SetRealInputDerivatives: the derivatives of θ_M (orders 1, 2) and ω_M (order 1) at
+    /// the start of the next step set the speed and acceleration of the main shaft's Taylor
+    /// polynomial over the step (a later call for the same quantity wins); the derivative of
+    /// τ_in (order 1) ramps the torque over the step (torque mode). Like the inputs, a
+    /// derivative holds until it is set again.
+    fn set_input_derivatives(&mut self, vrs: &[u32], orders: &[i32], values: &[f64]) -> FmiResult {
+        let mut targets = Vec::with_capacity(vrs.len());
+        for ((vr, order), value) in vrs.iter().zip(orders).zip(values) {
+            // Where the derivative is kept: an input variable, or τ_in's rate (None).
+            let target = match (*vr, *order) {
+                (vr::theta_M, 1) => Some(vr::omega_M),
+                (vr::theta_M, 2) | (vr::omega_M, 1) => Some(vr::alpha_M),
+                (vr::tau_in, 1) => None,
+                _ => {
+                    let name = contract::find(Kind::Real, *vr).map_or("?", |v| v.name);
+                    return Err(FmiError::error(format!(
+                        "derivative of order {order} of value reference {vr} ({name}) is not an input derivative of this model: theta_M takes orders 1 and 2, omega_M and tau_in order 1"
+                    )));
+                }
+            };
+            if !value.is_finite() {
+                return Err(FmiError::error(format!(
+                    "derivative {value} of order {order} refused: values must be finite"
+                )));
+            }
+            targets.push((target, *value));
+        }
+        for (target, value) in targets {
+            match target {
+                Some(vr) => self.values.set_real(vr, value),
+                None => self.values.set_tau_in_rate(value),
+            }
+        }
+        self.inputs_changed();
+        Ok(())
+    }
+
+    /// fmi2GetRealOutputDerivatives (order 1).
+    fn get_output_derivatives(
+        &mut self,
+        vrs: &[u32],
+        orders: &[i32],
+        out: &mut [f64],
+    ) -> FmiResult {
+        let sim = self.current()?;
+        for ((vr, order), out) in vrs.iter().zip(orders).zip(out) {
+            let var = Self::variable(Kind::Real, *vr)?;
+            *out = match (order, sim.real_output_derivative(*vr)) {
+                (1, Some(d)) => d,
+                _ => {
+                    return Err(FmiError::error(format!(
+                        "no derivative of order {order} for {}: order 1 is given for {}",
+                        var.name,
+                        contract::with_derivative().collect::<Vec<_>>().join(", ")
+                    )));
+                }
+            };
+        }
+        Ok(())
+    }
+
+    /// fmi2GetDirectionalDerivative: dv_unknown = J · dv_known with J = ∂outputs/∂inputs.
+    fn directional_derivative(
+        &mut self,
+        unknowns: &[u32],
+        knowns: &[u32],
+        dv_known: &[f64],
+        dv_unknown: &mut [f64],
+    ) -> FmiResult {
+        for k in knowns {
+            let var = Self::variable(Kind::Real, *k)?;
+            if var.causality != Causality::Input {
+                return Err(FmiError::error(format!(
+                    "{} is not an input: directional derivatives are taken with respect to theta_M, omega_M, alpha_M, tau_in",
+                    var.name
+                )));
+            }
+        }
+        let sim = self.current()?;
+        for (u, out) in unknowns.iter().zip(dv_unknown) {
+            let var = Self::variable(Kind::Real, *u)?;
+            if var.causality != Causality::Output {
+                return Err(FmiError::error(format!(
+                    "{} is not an output: directional derivatives are of outputs",
+                    var.name
+                )));
+            }
+            *out = knowns
+                .iter()
+                .zip(dv_known)
+                .map(|(k, dv)| sim.partial(*u, *k) * dv)
+                .sum();
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use fmi2_shell::fmu_state::{deserialize, serialize};
+
+    fn stepped() -> Instance {
+        let mut i = Instance::new(false);
+        i.set_integer(&[vr::excitation], &[1]).unwrap();
+        i.enter_initialization_mode().unwrap();
+        i.exit_initialization_mode().unwrap();
+        i.do_step(0.0, 0.01).unwrap();
+        i
+    }
+
+    /// A serialized state decodes to an instance that serializes to the same bytes.
+    #[test]
+    fn serialized_state_round_trip_is_exact() {
+        let i = stepped();
+        let back: Instance = deserialize(&serialize(&i)).unwrap();
+        assert_eq!(serialize(&back), serialize(&i));
+    }
+
+    /// Corrupt, cut, foreign and other-version bytes are refused with the reason.
+    #[test]
+    fn corrupt_or_foreign_states_are_refused() {
+        let bytes = serialize(&stepped());
+        let refused = |b: &[u8]| deserialize::<Instance>(b).unwrap_err().message;
+        let mut flipped = bytes.clone();
+        flipped[13] ^= 1;
+        assert!(refused(&flipped).contains("checksum"));
+        assert!(refused(&bytes[..bytes.len() - 1]).contains("length"));
+        assert!(refused(b"hello world, not a state").contains("GRFS"));
+        let mut version = bytes.clone();
+        version[4] = 9;
+        assert!(refused(&version).contains("version"));
     }
 }

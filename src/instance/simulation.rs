@@ -8,8 +8,8 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::error::{FmiError, FmiResult};
 use super::values::Values;
+use super::{FmiError, FmiResult};
 use crate::contract::vr;
 use crate::integrator::{Jacobian, Method, Piecewise, Solver, SolverError, Stats};
 use crate::physics::{

@@ -1,0 +1,387 @@
+//! Build-time generator (feature "build"), for the FMUs' build scripts: turns a contract
+//! TOML (the one source of truth for a model's variables, units and capabilities) into
+//!   - `$OUT_DIR/modelDescription.xml`, the FMI 2.0 model description packaged in the FMU;
+//!   - `$OUT_DIR/contract.rs`, the value references, start values, causalities, log
+//!     categories and GUID the model uses (included by its `contract` module after
+//!     `use fmi2_shell::contract::*`);
+//!
+//! and restricts the cdylib's exports to the `fmi2*` functions ([`restrict_exports`]).
+//!
+//! The GUID is a hash of the contract file, so the XML and the binary always carry the same
+//! one and any change of the contract changes it.
+
+use serde::Deserialize;
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use std::{env, fs, path::PathBuf};
+
+#[derive(Deserialize)]
+struct Contract {
+    model: Model,
+    capabilities: BTreeMap<String, toml::Value>,
+    experiment: BTreeMap<String, f64>,
+    log_categories: Vec<(String, String)>,
+    unit: Vec<Unit>,
+    variable: Vec<Variable>,
+}
+
+#[derive(Deserialize)]
+struct Model {
+    name: String,
+    identifier: String,
+    description: String,
+    version: String,
+    author: String,
+}
+
+#[derive(Deserialize)]
+struct Unit {
+    name: String,
+    base: BTreeMap<String, i32>,
+    #[serde(default)]
+    display: Vec<DisplayUnit>,
+}
+
+#[derive(Deserialize)]
+struct DisplayUnit {
+    name: String,
+    factor: f64,
+}
+
+#[derive(Deserialize)]
+struct Variable {
+    name: String,
+    vr: u32,
+    #[serde(rename = "type")]
+    ty: String,
+    causality: String,
+    description: String,
+    start: Option<toml::Value>,
+    unit: Option<String>,
+    display_unit: Option<String>,
+    min: Option<toml::Value>,
+    max: Option<toml::Value>,
+    depends_on: Option<Vec<String>>,
+    /// The FMU gives this output's first time derivative (fmi2GetRealOutputDerivatives).
+    #[serde(default)]
+    derivative: bool,
+}
+
+impl Variable {
+    fn variability(&self) -> &'static str {
+        match (self.causality.as_str(), self.ty.as_str()) {
+            ("parameter", _) => "fixed",
+            (_, "Integer") => "discrete",
+            _ => "continuous",
+        }
+    }
+}
+
+/// Generates the model description and the Rust constants of the contract at `path`
+/// (relative to the crate's manifest directory), and asks cargo to rerun when it changes.
+pub fn generate(path: &str) {
+    println!("cargo:rerun-if-changed={path}");
+    let text = fs::read_to_string(path).unwrap_or_else(|e| panic!("{path}: {e}"));
+    let contract: Contract = toml::from_str(&text).unwrap_or_else(|e| panic!("{path}: {e}"));
+    check(&contract);
+    let guid = guid_of(&text);
+    let out = PathBuf::from(env::var("OUT_DIR").unwrap());
+    fs::write(out.join("modelDescription.xml"), xml(&contract, &guid)).unwrap();
+    fs::write(out.join("contract.rs"), rust(&contract, &guid)).unwrap();
+}
+
+/// Refuses a contract that would give an invalid or ambiguous FMU.
+fn check(c: &Contract) {
+    let mut seen = BTreeMap::new();
+    for v in &c.variable {
+        assert!(
+            seen.insert((v.ty.clone(), v.vr), &v.name).is_none(),
+            "value reference {} used twice for type {}",
+            v.vr,
+            v.ty
+        );
+        assert!(
+            ["parameter", "input", "output"].contains(&v.causality.as_str()),
+            "{}: unknown causality {}",
+            v.name,
+            v.causality
+        );
+        assert!(
+            ["Real", "Integer"].contains(&v.ty.as_str()),
+            "{}: unknown type {}",
+            v.name,
+            v.ty
+        );
+        assert!(
+            v.causality == "output" || v.start.is_some(),
+            "{}: parameters and inputs need a start value",
+            v.name
+        );
+        if let Some(u) = &v.unit {
+            assert!(
+                c.unit.iter().any(|d| &d.name == u),
+                "{}: unit {u} is not defined",
+                v.name
+            );
+        }
+        assert!(
+            !v.derivative || (v.causality == "output" && v.ty == "Real"),
+            "{}: only Real outputs have derivatives",
+            v.name
+        );
+        for d in v.depends_on.iter().flatten() {
+            assert!(
+                c.variable
+                    .iter()
+                    .any(|w| &w.name == d && w.causality == "input"),
+                "{}: depends on {d}, which is not an input",
+                v.name
+            );
+        }
+    }
+}
+
+/// FNV-1a over the contract text, twice with different offsets, formatted as a GUID.
+fn guid_of(text: &str) -> String {
+    let fnv = |offset: u64| {
+        text.bytes().fold(offset, |h, b| {
+            (h ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3)
+        })
+    };
+    let (a, b) = (fnv(0xcbf2_9ce4_8422_2325), fnv(0x6c62_272e_07bb_0142));
+    format!(
+        "{{{:08x}-{:04x}-{:04x}-{:04x}-{:012x}}}",
+        a >> 32,
+        (a >> 16) & 0xffff,
+        a & 0xffff,
+        b >> 48,
+        b & 0xffff_ffff_ffff
+    )
+}
+
+fn esc(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+}
+
+fn value(v: &toml::Value) -> String {
+    match v {
+        toml::Value::Float(f) => format!("{f:?}"),
+        toml::Value::Integer(i) => i.to_string(),
+        toml::Value::Boolean(b) => b.to_string(),
+        toml::Value::String(s) => esc(s),
+        other => panic!("unsupported value {other}"),
+    }
+}
+
+fn xml(c: &Contract, guid: &str) -> String {
+    let mut x = String::new();
+    let m = &c.model;
+    x += "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
+    writeln!(
+        x,
+        "<fmiModelDescription fmiVersion=\"2.0\" modelName=\"{}\" guid=\"{guid}\" description=\"{}\" author=\"{}\" version=\"{}\" generationTool=\"fmi2-shell\" variableNamingConvention=\"flat\" numberOfEventIndicators=\"0\">",
+        esc(&m.name),
+        esc(&m.description),
+        esc(&m.author),
+        esc(&m.version)
+    )
+    .unwrap();
+    write!(x, "  <CoSimulation modelIdentifier=\"{}\"", m.identifier).unwrap();
+    for (k, v) in &c.capabilities {
+        write!(x, " {k}=\"{}\"", value(v)).unwrap();
+    }
+    x += "/>\n  <UnitDefinitions>\n";
+    for u in &c.unit {
+        write!(x, "    <Unit name=\"{}\"><BaseUnit", esc(&u.name)).unwrap();
+        for (k, e) in &u.base {
+            write!(x, " {k}=\"{e}\"").unwrap();
+        }
+        x += "/>";
+        for d in &u.display {
+            write!(
+                x,
+                "<DisplayUnit name=\"{}\" factor=\"{:?}\"/>",
+                esc(&d.name),
+                d.factor
+            )
+            .unwrap();
+        }
+        x += "</Unit>\n";
+    }
+    x += "  </UnitDefinitions>\n  <LogCategories>\n";
+    for (name, description) in &c.log_categories {
+        writeln!(
+            x,
+            "    <Category name=\"{name}\" description=\"{}\"/>",
+            esc(description)
+        )
+        .unwrap();
+    }
+    x += "  </LogCategories>\n  <DefaultExperiment";
+    for (k, v) in &c.experiment {
+        write!(x, " {k}=\"{v:?}\"").unwrap();
+    }
+    x += "/>\n  <ModelVariables>\n";
+    for (i, v) in c.variable.iter().enumerate() {
+        writeln!(x, "    <!-- index {} -->", i + 1).unwrap();
+        write!(
+            x,
+            "    <ScalarVariable name=\"{}\" valueReference=\"{}\" description=\"{}\" causality=\"{}\" variability=\"{}\"",
+            esc(&v.name),
+            v.vr,
+            esc(&v.description),
+            v.causality,
+            v.variability()
+        )
+        .unwrap();
+        if v.causality == "parameter" {
+            x += " initial=\"exact\"";
+        }
+        write!(x, ">\n      <{}", v.ty).unwrap();
+        if let Some(s) = &v.start {
+            write!(x, " start=\"{}\"", value(s)).unwrap();
+        }
+        if let Some(u) = &v.unit {
+            write!(x, " unit=\"{}\"", esc(u)).unwrap();
+        }
+        if let Some(u) = &v.display_unit {
+            write!(x, " displayUnit=\"{}\"", esc(u)).unwrap();
+        }
+        if let Some(b) = &v.min {
+            write!(x, " min=\"{}\"", value(b)).unwrap();
+        }
+        if let Some(b) = &v.max {
+            write!(x, " max=\"{}\"", value(b)).unwrap();
+        }
+        x += "/>\n    </ScalarVariable>\n";
+    }
+    x += "  </ModelVariables>\n  <ModelStructure>\n    <Outputs>\n";
+    let index_of = |name: &str| 1 + c.variable.iter().position(|w| w.name == name).unwrap();
+    let outputs: Vec<_> = (1..)
+        .zip(&c.variable)
+        .filter(|(_, v)| v.causality == "output")
+        .collect();
+    for (i, v) in &outputs {
+        let deps: Vec<String> = v
+            .depends_on
+            .iter()
+            .flatten()
+            .map(|d| index_of(d).to_string())
+            .collect();
+        if deps.is_empty() {
+            writeln!(x, "      <Unknown index=\"{i}\" dependencies=\"\"/>").unwrap();
+        } else {
+            let kinds = vec!["dependent"; deps.len()].join(" ");
+            writeln!(
+                x,
+                "      <Unknown index=\"{i}\" dependencies=\"{}\" dependenciesKind=\"{kinds}\"/>",
+                deps.join(" ")
+            )
+            .unwrap();
+        }
+    }
+    x += "    </Outputs>\n    <InitialUnknowns>\n";
+    for (i, _) in &outputs {
+        writeln!(x, "      <Unknown index=\"{i}\"/>").unwrap();
+    }
+    x += "    </InitialUnknowns>\n  </ModelStructure>\n</fmiModelDescription>\n";
+    x
+}
+
+fn rust(c: &Contract, guid: &str) -> String {
+    let mut r =
+        String::from("// Generated by fmi2-shell from the model's contract: do not edit.\n");
+    writeln!(r, "pub const GUID: &str = {guid:?};").unwrap();
+    writeln!(
+        r,
+        "pub const MODEL_IDENTIFIER: &str = {:?};",
+        c.model.identifier
+    )
+    .unwrap();
+    writeln!(r, "pub const MODEL_NAME: &str = {:?};", c.model.name).unwrap();
+    writeln!(
+        r,
+        "pub const DEFAULT_TOLERANCE: f64 = {:?};",
+        c.experiment["tolerance"]
+    )
+    .unwrap();
+    r += "pub const LOG_CATEGORIES: &[(&str, &str)] = &[\n";
+    for (n, d) in &c.log_categories {
+        writeln!(r, "    ({n:?}, {d:?}),").unwrap();
+    }
+    r += "];\n\n/// Indices in LOG_CATEGORIES, named as the categories.\n#[allow(non_upper_case_globals)]\npub mod log {\n";
+    for (i, (n, _)) in c.log_categories.iter().enumerate() {
+        writeln!(r, "    pub const {n}: usize = {i};").unwrap();
+    }
+    r += "}\n\n/// Value references, named as the variables.\n#[allow(non_upper_case_globals)]\npub mod vr {\n";
+    for v in &c.variable {
+        writeln!(r, "    pub const {}: u32 = {};", v.name, v.vr).unwrap();
+    }
+    r += "}\n\n/// Every variable of the contract, in the order of the model description.\npub static VARIABLES: &[Variable] = &[\n";
+    for v in &c.variable {
+        let start = match (&v.ty[..], &v.start) {
+            (_, None) => "Start::None".to_string(),
+            ("Real", Some(s)) => format!(
+                "Start::Real({:?})",
+                s.as_float()
+                    .or(s.as_integer().map(|i| i as f64))
+                    .expect("a number")
+            ),
+            (_, Some(s)) => format!("Start::Integer({})", s.as_integer().expect("an integer")),
+        };
+        let causality = match &v.causality[..] {
+            "parameter" => "Parameter",
+            "input" => "Input",
+            _ => "Output",
+        };
+        writeln!(
+            r,
+            "    Variable {{ name: {:?}, vr: {}, kind: Kind::{}, causality: Causality::{causality}, start: {start}, unit: {:?}, depends_on: &{:?}, derivative: {}, description: {:?} }},",
+            v.name,
+            v.vr,
+            v.ty,
+            v.unit.as_deref().unwrap_or(""),
+            v.depends_on.as_deref().unwrap_or_default(),
+            v.derivative,
+            v.description
+        )
+        .unwrap();
+    }
+    r += "];\n\n/// Index in VARIABLES of the variable of a kind and value reference (a jump table, not\n/// a search: fmi2GetReal looks every reference up).\npub fn index(kind: Kind, vr: u32) -> Option<usize> {\n    match (kind, vr) {\n";
+    for (i, v) in c.variable.iter().enumerate() {
+        writeln!(r, "        (Kind::{}, {}) => Some({i}),", v.ty, v.vr).unwrap();
+    }
+    r += "        _ => None,\n    }\n}\n";
+    r
+}
+
+/// Keeps the shared library's exports to the FMI functions: a cdylib otherwise exports every
+/// `#[no_mangle]` symbol of its dependencies too (fmi-sys brings `callback_log`). rustc's own
+/// version script names those symbols as global, and GNU ld lets an explicit name win over
+/// our wildcard, so the one fmi-sys brings is named here (a test checks the export table).
+///
+/// Windows (x86_64-pc-windows-gnu): rustc hands GNU ld a .def list of the same symbols, and
+/// ld's PE back end can only add to such a list (a second .def is merged into it;
+/// --exclude-symbols only affects automatic exports), so nothing here can take a name out.
+/// The linker set in .cargo/config.toml, mk/windows-link.sh, links with a copy of rustc's
+/// list narrowed to fmi2*; tests/windows/run.sh checks the DLL's export table.
+pub fn restrict_exports() {
+    let out = PathBuf::from(env::var("OUT_DIR").unwrap());
+    let target_os = env::var("CARGO_CFG_TARGET_OS").unwrap_or_default();
+    if target_os != "linux" {
+        return;
+    }
+    let script = out.join("exports.map");
+    fs::write(
+        &script,
+        "{\n  global: fmi2*;\n  local: callback_log; *;\n};\n",
+    )
+    .unwrap();
+    println!(
+        "cargo:rustc-cdylib-link-arg=-Wl,--version-script={}",
+        script.display()
+    );
+}

@@ -1,0 +1,38 @@
+//! fmi2-shell: the FMI 2.0 layer of GearRattle and its partner FMUs, written once.
+//!
+//! A model is a [`Slave`]: a typed Rust value with methods for the FMI calls, free of C
+//! types. The shell gives it
+//! - the C exports ([`export_co_simulation!`]), each a guard ([`component`]) that checks the
+//!   state machine ([`state`]), unpacks the C arguments, catches panics, and hands log
+//!   lines ([`log`]) to the importer's logger ([`logger`]);
+//! - FMU states ([`fmu_state`]): boxed copies, and their serialized form with the model's
+//!   magic, version, GUID and a CRC;
+//! - statuses and errors in FMI's terms ([`status`]);
+//! - the types of the contract ([`contract`]) and, for build scripts, the generator of the
+//!   model description and of the constants from the contract TOML (`build`, feature
+//!   "build").
+
+#[cfg(feature = "build")]
+pub mod build;
+#[cfg(feature = "runtime")]
+pub mod component;
+pub mod contract;
+#[cfg(feature = "runtime")]
+pub mod export;
+#[cfg(feature = "runtime")]
+pub mod fmu_state;
+pub mod log;
+#[cfg(feature = "runtime")]
+pub mod logger;
+#[cfg(feature = "runtime")]
+mod macros;
+pub mod slave;
+pub mod state;
+pub mod status;
+
+#[cfg(feature = "runtime")]
+pub use fmi_sys::fmi2;
+pub use log::{Log, Message};
+pub use slave::{Identity, Slave};
+pub use state::FmiState;
+pub use status::{FmiError, FmiResult, Status};

@@ -1,0 +1,108 @@
+//! What a model gives the shell: a co-simulation slave as a typed Rust value, free of C
+//! types. The shell's C exports check the state machine, unpack the arguments, call these
+//! methods, and turn their results into statuses and log lines.
+
+use crate::log::{Categories, Log};
+use crate::state::FmiState;
+use crate::status::{FmiError, FmiResult};
+use serde::Serialize;
+use serde::de::DeserializeOwned;
+
+/// Who a model is: what fmi2Instantiate checks and what tags its FMU states.
+pub struct Identity {
+    /// The GUID of the model description the binary was built with.
+    pub guid: &'static str,
+    pub model_identifier: &'static str,
+    /// Log categories, errors first, then warnings ([`Log`]).
+    pub log_categories: Categories,
+    /// First bytes of a serialized FMU state, and its format's version (raised whenever the
+    /// slave's serialized shape changes).
+    pub state_magic: [u8; 4],
+    pub state_version: u16,
+}
+
+/// A co-simulation slave. Everything but its [`Log`] is its FMU state (clone and serde).
+pub trait Slave: Clone + Serialize + DeserializeOwned {
+    const IDENTITY: Identity;
+
+    /// A fresh instance (state Instantiated, start values), logging as `logging_on` says.
+    fn new(logging_on: bool) -> Self;
+
+    fn log(&mut self) -> &mut Log;
+
+    fn state(&self) -> FmiState;
+
+    /// Sets the state: the shell moves a slave into [`FmiState::Error`] after a panic.
+    fn set_state(&mut self, state: FmiState);
+
+    fn setup_experiment(&mut self, tolerance: Option<f64>, start_time: f64) -> FmiResult;
+    fn enter_initialization_mode(&mut self) -> FmiResult;
+    fn exit_initialization_mode(&mut self) -> FmiResult;
+    fn terminate(&mut self) -> FmiResult;
+
+    fn get_real(&mut self, vrs: &[u32], out: &mut [f64]) -> FmiResult;
+    fn get_integer(&mut self, vrs: &[u32], out: &mut [i32]) -> FmiResult;
+    fn set_real(&mut self, vrs: &[u32], values: &[f64]) -> FmiResult;
+    fn set_integer(&mut self, vrs: &[u32], values: &[i32]) -> FmiResult;
+
+    fn do_step(&mut self, current: f64, h: f64) -> FmiResult;
+    /// fmi2LastSuccessfulTime.
+    fn last_successful_time(&self) -> f64;
+
+    /// fmi2SetRealInputDerivatives (canInterpolateInputs).
+    fn set_input_derivatives(
+        &mut self,
+        _vrs: &[u32],
+        _orders: &[i32],
+        _values: &[f64],
+    ) -> FmiResult {
+        Err(unsupported("fmi2SetRealInputDerivatives"))
+    }
+
+    /// fmi2GetRealOutputDerivatives (maxOutputDerivativeOrder).
+    fn get_output_derivatives(
+        &mut self,
+        _vrs: &[u32],
+        _orders: &[i32],
+        _out: &mut [f64],
+    ) -> FmiResult {
+        Err(unsupported("fmi2GetRealOutputDerivatives"))
+    }
+
+    /// fmi2GetDirectionalDerivative (providesDirectionalDerivative).
+    fn directional_derivative(
+        &mut self,
+        _unknowns: &[u32],
+        _knowns: &[u32],
+        _dv_known: &[f64],
+        _dv_unknown: &mut [f64],
+    ) -> FmiResult {
+        Err(unsupported("fmi2GetDirectionalDerivative"))
+    }
+}
+
+/// The error of a function the model's capabilities do not declare.
+pub fn unsupported(function: &str) -> FmiError {
+    FmiError::error(format!(
+        "{function} is not supported: the model description does not declare that capability"
+    ))
+}
+
+/// A copy of the FMU state: the slave without its queued log lines.
+pub fn snapshot<S: Slave>(slave: &S) -> S {
+    let mut copy = slave.clone();
+    copy.log().messages.clear();
+    copy
+}
+
+/// Takes over a saved FMU state, keeping the slave's logging settings and lines.
+pub fn restore<S: Slave>(slave: &mut S, saved: &S) {
+    let log = std::mem::take(slave.log());
+    *slave = saved.clone();
+    *slave.log() = log;
+}
+
+/// fmi2Reset: back to the state after instantiation, the logging settings kept.
+pub fn reset<S: Slave>(slave: &mut S) {
+    restore(slave, &S::new(false));
+}
