@@ -78,3 +78,14 @@ def test_interrupted_study_resumes_without_recomputing(fmu, tmp_path):
     assert "points already in" in again.stdout
     assert rows(out).equals(rows(ref))
     assert len(_partials(out)) > kept
+
+
+def test_refused_points_are_rows_with_the_fmu_message(fmu, tmp_path):
+    """G <= 0 passes the study's checks (the FMU declares no minimum) and the FMU refuses it:
+    the point is a row with status refused and the FMU's message, the others are computed."""
+    out = str(tmp_path / "doe")
+    study("doe", "--fmu", fmu, "--out", out, "--workers", "0", "--param", "G=-1e-5:5e-5",
+          "--design", "full", "--n", "4", "--duration", "0.2")
+    t = rows(out).to_pylist()
+    assert [r["status"] for r in t] == ["refused", "ok", "ok", "ok"]
+    assert "G" in t[0]["message"] and "invalid" in t[0]["message"], t[0]["message"]

@@ -2,11 +2,10 @@
 flag) and the fix, and no results directory."""
 
 import os
-import textwrap
 
 import pytest
 
-from gearrattle.study import cli
+from gearrattle.study import cli, spec
 from study_support import fmu  # noqa: F401 (fixture)
 
 GOOD = """\
@@ -81,3 +80,21 @@ def test_bad_flags_are_refused_before_running(args, words, fmu, tmp_path, capsys
     for w in words:
         assert w in err, err
     assert not os.path.exists(out)
+
+
+def test_stats_from_on_an_fmu_without_it_is_refused(fmu):
+    """--stats-from sets the FMU's stats_from; an FMU without that parameter is refused, not
+    run with the window silently at 0 (the FMU read, then stats_from taken out of it)."""
+    import dataclasses
+
+    from gearrattle.study.model import read_model
+
+    model = read_model(fmu)
+    older = dataclasses.replace(model, parameters={k: v for k, v in model.parameters.items()
+                                                   if k != "stats_from"})
+    st = spec.Study(kind="map", fmu=fmu, out="unused", stats_from=(0.3, "--stats-from 0.3"))
+    st.axes = [spec.parse_axis("f_exc=30:60:2", "--x"), spec.parse_axis("A_rms=100:700:2", "--y")]
+    with pytest.raises(spec.StudyError, match=r"--stats-from 0.3: this FMU has no parameter "
+                                              r"stats_from.*make fmu"):
+        spec.validate(st, older)
+    assert spec.validate(st, model).stats_from[0] == 0.3
