@@ -71,8 +71,10 @@ def test_good_study_file_runs(fmu, tmp_path):
                                                            "LO < HI"]),
     (["mc", "--dist", "g=normal:2e-5:1e-6", "--n", "4"], ["'g'", "did you mean G"]),
     (["map", "--set", "solver=7"], ["solver = 7", "maximum 2"]),
+    (["mc", "--dist", "G=uniform:2e-5:3e-5", "--n", "4", "--set", "f_exc=30", "--at",
+      "f_exc=40"], ["--at f_exc=40", "also set or varied", "remove one"]),
 ], ids=["map empty range", "doe empty range", "mc negative width", "unknown name",
-        "above maximum"])
+        "above maximum", "set and operating point"])
 def test_bad_flags_are_refused_before_running(args, words, fmu, tmp_path, capsys):
     out = tmp_path / "results"
     assert cli.main([*args, "--fmu", fmu, "--out", str(out)]) == 2
@@ -98,3 +100,14 @@ def test_stats_from_on_an_fmu_without_it_is_refused(fmu):
                                               r"stats_from.*make fmu"):
         spec.validate(st, older)
     assert spec.validate(st, model).stats_from[0] == 0.3
+
+
+def test_empty_range_in_a_doe_file_is_refused(fmu, tmp_path, capsys):
+    out = tmp_path / "results"
+    path = tmp_path / "doe.toml"
+    path.write_text(f'kind = "doe"\nout = "{out}"\nfmu = "{fmu}"\nn = 8\n'
+                    f'param = ["G=10e-6:80e-6",\n         "C=0.05:0.005"]\n')
+    assert cli.main(["run", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert "line 6" in err and "empty range C" in err and "LO < HI" in err, err
+    assert not os.path.exists(out)

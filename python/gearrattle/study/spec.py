@@ -355,9 +355,10 @@ def validate(st, model):
     for point, where in st.at:
         for name, value in point.items():
             _check_name(name, where, model, False)
-            if name in seen:
-                raise StudyError(f"{where}: {name} is both an operating point and varied "
-                                 f"(at {seen[name]}): remove one")
+            if name in seen or name in st.fixed:
+                other = seen.get(name) or st.fixed[name][1]
+                raise StudyError(f"{where}: {name} is in an operating point and also set or "
+                                 f"varied (at {other}): remove one")
             _check_bounds(name, value, value, where, model, "operating point")
     for a in st.axes:
         _check_bounds(a.name, a.lo, a.hi, a.where, model, "range of")
