@@ -109,9 +109,9 @@ def classify(r):
     return ("transient" if lp + lm == 0 else "sustained"), lp, lm
 
 
-def _run_levels(study, model, data, session, points, name):
-    """Classes of the levels {(f, A)} run as one study in study.out/name."""
-    study.out = os.path.join(study.base, name)
+def _run_levels(study, model, data, session, points, out):
+    """Classes of the levels {(f, A)} run as one study in out."""
+    study.out = out
     table = engine.execute(study, model, data, points=[{"f_exc": f, "A_rms": A}
                                                          for f, A in points], session=session)
     res = {(r["f_exc"], r["A_rms"]): r for r in table.to_pylist()}
@@ -134,14 +134,15 @@ def scan_one(f, levels, classes, meta):
     return scan, streak
 
 
-def thresholds(study, model, data, session, fs, meta):
-    """A_first and A_sustained at each frequency (geometric scan, then rounds of bisection)."""
+def thresholds(study, model, data, session, fs, meta, base):
+    """A_first and A_sustained at each frequency (geometric scan, then rounds of bisection);
+    the runner's points in base/scan, base/bisection1, ..."""
     levels, A = [], meta["thr_lo"]
     while A <= meta["thr_hi"]:
         levels.append(A)
         A *= meta["thr_ratio"]
     classes = _run_levels(study, model, data, session, [(f, A) for f in fs for A in levels],
-                          "scan")
+                          os.path.join(base, "scan"))
     out, brackets = {}, {}
     for f in fs:
         scan, streak = scan_one(f, levels, classes, meta)
@@ -169,8 +170,9 @@ def thresholds(study, model, data, session, fs, meta):
     while active:
         rnd += 1
         mids = {k: math.sqrt(lo * hi) for k, (lo, hi) in active.items()}
-        res = _run_levels(study, model, data, session, sorted({(f, A) for (f, _), A in
-                                                               mids.items()}), f"bisection{rnd}")
+        todo = sorted({(f, A) for (f, _), A in mids.items()})
+        res = _run_levels(study, model, data, session, todo,
+                          os.path.join(base, f"bisection{rnd}"))
         for (f, edge), mid in mids.items():
             (c, _, _), msg = res[(f, mid)]
             out[f]["sims"] += 1
@@ -613,8 +615,8 @@ def main(argv=None):
             tst = spec.Study(kind="map", fmu=args.fmu, out="", fixed=grid.fixed,
                              duration=args.threshold_duration,
                              stats_from=(win, "threshold window"), record=COUNTS)
-            tst.base = os.path.join(args.out, "threshold")
-            thr = thresholds(tst, model, data, session, fs, meta)
+            thr = thresholds(tst, model, data, session, fs, meta,
+                             os.path.join(args.out, "threshold"))
     wall = time.perf_counter() - t_all
     rows = grid_rows(table, args.duration, args.t_from)
     os.makedirs(args.out, exist_ok=True)
