@@ -12,11 +12,6 @@ include!(concat!(env!("OUT_DIR"), "/contract.rs"));
 pub const MODEL_DESCRIPTION_XML: &str =
     include_str!(concat!(env!("OUT_DIR"), "/modelDescription.xml"));
 
-/// Looks a variable up by kind and value reference.
-pub fn find(kind: Kind, vr: u32) -> Option<&'static Variable> {
-    index(kind, vr).map(|i| &VARIABLES[i])
-}
-
 /// The names of the outputs whose first derivative the FMU gives.
 pub fn with_derivative() -> impl Iterator<Item = &'static str> {
     VARIABLES.iter().filter(|v| v.derivative).map(|v| v.name)

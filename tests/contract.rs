@@ -3,14 +3,14 @@
 //! where the contract says so, and each Real output moves with an input at once exactly
 //! where its `depends_on` (the model description's ModelStructure) says so.
 
+use fmi2_shell::values::Values;
 use gear_rattle::contract::{Causality, Kind, VARIABLES, Variable, vr};
 use gear_rattle::instance::Simulation;
-use gear_rattle::instance::values::Values;
 
 /// A simulation in contact on F+ and moving (so that the contact's stiffness and damping
 /// both act), with the main shaft driven by `excitation`.
 fn in_contact(excitation: i64) -> Simulation {
-    let mut values = Values::start();
+    let mut values = Values::start(gear_rattle::contract::VARIABLES);
     values.set_integer(vr::excitation, excitation);
     values.set_real(vr::gap_start, -0.2);
     values.set_real(vr::xi_dot_start, 0.01);
@@ -18,7 +18,7 @@ fn in_contact(excitation: i64) -> Simulation {
     values.set_real(vr::alpha_M, 40.0);
     values.set_real(vr::tau_in, 0.5);
     values.set_real(vr::stats_from, 0.0);
-    Simulation::new(&values, 0.0, 1e-6).expect("valid parameters")
+    Simulation::new(&values, 0.0, 0.0, 1e-6).expect("valid parameters")
 }
 
 fn outputs(kind: Kind) -> impl Iterator<Item = &'static Variable> {

@@ -302,12 +302,9 @@ fn rust(c: &Contract, guid: &str) -> String {
     )
     .unwrap();
     writeln!(r, "pub const MODEL_NAME: &str = {:?};", c.model.name).unwrap();
-    writeln!(
-        r,
-        "pub const DEFAULT_TOLERANCE: f64 = {:?};",
-        c.experiment["tolerance"]
-    )
-    .unwrap();
+    if let Some(tolerance) = c.experiment.get("tolerance") {
+        writeln!(r, "pub const DEFAULT_TOLERANCE: f64 = {tolerance:?};").unwrap();
+    }
     r += "pub const LOG_CATEGORIES: &[(&str, &str)] = &[\n";
     for (n, d) in &c.log_categories {
         writeln!(r, "    ({n:?}, {d:?}),").unwrap();
@@ -354,7 +351,7 @@ fn rust(c: &Contract, guid: &str) -> String {
     for (i, v) in c.variable.iter().enumerate() {
         writeln!(r, "        (Kind::{}, {}) => Some({i}),", v.ty, v.vr).unwrap();
     }
-    r += "        _ => None,\n    }\n}\n";
+    r += "        _ => None,\n    }\n}\n\n/// Looks a variable up by kind and value reference.\npub fn find(kind: Kind, vr: u32) -> Option<&'static Variable> {\n    index(kind, vr).map(|i| &VARIABLES[i])\n}\n";
     r
 }
 

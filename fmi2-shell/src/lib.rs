@@ -7,7 +7,8 @@
 //!   lines ([`log`]) to the importer's logger ([`logger`]);
 //! - FMU states ([`fmu_state`]): boxed copies, and their serialized form with the model's
 //!   magic, version, GUID and a CRC;
-//! - statuses and errors in FMI's terms ([`status`]);
+//! - statuses and errors in FMI's terms ([`status`]), and the store of the values set
+//!   ([`values`]);
 //! - the types of the contract ([`contract`]) and, for build scripts, the generator of the
 //!   model description and of the constants from the contract TOML (`build`, feature
 //!   "build").
@@ -29,6 +30,7 @@ mod macros;
 pub mod slave;
 pub mod state;
 pub mod status;
+pub mod values;
 
 #[cfg(feature = "runtime")]
 pub use fmi_sys::fmi2;

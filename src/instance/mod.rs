@@ -4,7 +4,6 @@
 //! results into fmi2Status and log lines.
 
 pub mod simulation;
-pub mod values;
 
 pub use fmi2_shell::{FmiError, FmiResult, FmiState, Status};
 pub use simulation::Simulation;
@@ -12,9 +11,9 @@ pub use simulation::Simulation;
 use crate::contract::{self, Causality, Kind, LOG_CATEGORIES, vr};
 use crate::physics::Shaft;
 use crate::rattle::Impacts;
+use fmi2_shell::values::Values;
 use fmi2_shell::{Identity, Log, Slave};
 use serde::{Deserialize, Serialize};
-use values::Values;
 
 /// The contract's log categories by role (errors and warnings first, as the shell wants).
 const EVENTS: usize = contract::log::logEvents;
@@ -29,6 +28,9 @@ const _: () = assert!(contract::log::logStatusWarning == fmi2_shell::log::WARNIN
 pub struct Instance {
     pub state: FmiState,
     values: Values,
+    /// dτ_in/dt from fmi2SetRealInputDerivatives [N m/s] (0 until set: a held torque); the
+    /// derivatives of θ_M and ω_M are kept as the inputs omega_M and alpha_M.
+    tau_in_rate: f64,
     start_time: f64,
     tolerance: Option<f64>,
     /// The running model; built at fmi2ExitInitializationMode (and for reads during
@@ -59,7 +61,7 @@ impl Instance {
 
     fn build(&self) -> FmiResult<Simulation> {
         let rtol = self.tolerance.unwrap_or(contract::DEFAULT_TOLERANCE);
-        Simulation::new(&self.values, self.start_time, rtol)
+        Simulation::new(&self.values, self.tau_in_rate, self.start_time, rtol)
     }
 
     /// The running simulation, or during initialisation one built from the values so far.
@@ -116,7 +118,7 @@ impl Instance {
                     omega: self.values.real(vr::omega_M),
                     alpha: self.values.real(vr::alpha_M),
                 };
-                let (tau, rate) = (self.values.real(vr::tau_in), self.values.tau_in_rate());
+                let (tau, rate) = (self.values.real(vr::tau_in), self.tau_in_rate);
                 let sim = self.sim.as_mut().expect("initialised");
                 let before = sim.impacts();
                 sim.set_shaft(shaft);
@@ -263,7 +265,8 @@ impl Slave for Instance {
     fn new(logging_on: bool) -> Self {
         Instance {
             state: FmiState::Instantiated,
-            values: Values::start(),
+            values: Values::start(contract::VARIABLES),
+            tau_in_rate: 0.0,
             start_time: 0.0,
             tolerance: None,
             sim: None,
@@ -443,7 +446,7 @@ impl Slave for Instance {
         for (target, value) in targets {
             match target {
                 Some(vr) => self.values.set_real(vr, value),
-                None => self.values.set_tau_in_rate(value),
+                None => self.tau_in_rate = value,
             }
         }
         self.inputs_changed();

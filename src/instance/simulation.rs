@@ -8,7 +8,6 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::values::Values;
 use super::{FmiError, FmiResult};
 use crate::contract::vr;
 use crate::integrator::{Jacobian, Method, Piecewise, Solver, SolverError, Stats};
@@ -18,6 +17,7 @@ use crate::physics::{
 use crate::rattle::torque::{self, TorqueRattle};
 use crate::rattle::window::{Metrics, Quadratures, Window, quadrature};
 use crate::rattle::{self, GearPair, Impacts, Rattle};
+use fmi2_shell::values::Values;
 
 /// Values of the `excitation` parameter.
 pub const EXCITATION_INPUTS: i64 = 0;
@@ -198,8 +198,9 @@ fn check(name: &str, value: f64, ok: bool, allowed: &str) -> FmiResult {
 impl Simulation {
     /// Validates the parameters and builds the initial state at t0 (MODEL.md §1:
     /// ξ(0) = gap_start·G, ξ'(0) = xi_dot_start; in torque mode the shaft starts from the
-    /// values of the inputs theta_M and omega_M, θ_M(0) = theta_M, ω_M(0) = omega_M).
-    pub fn new(values: &Values, t0: f64, rtol: f64) -> FmiResult<Self> {
+    /// values of the inputs theta_M and omega_M, θ_M(0) = theta_M, ω_M(0) = omega_M, and
+    /// τ_in ramps at `tau_in_rate`, the derivative fmi2SetRealInputDerivatives gave).
+    pub fn new(values: &Values, tau_in_rate: f64, t0: f64, rtol: f64) -> FmiResult<Self> {
         let params = gear_params(values);
         params
             .validate()
@@ -233,7 +234,7 @@ impl Simulation {
             EXCITATION_SINE => Drive::Sine(Sine::new(a_rms, f_exc, omega_mean)),
             EXCITATION_TORQUE => Drive::Torque {
                 tau: param(values, vr::tau_in),
-                rate: values.tau_in_rate(),
+                rate: tau_in_rate,
             },
             other => {
                 return Err(FmiError::error(format!(

@@ -2,10 +2,13 @@
 //! flywheel with 2nd-order firing acyclism that drives the gearbox main shaft through a
 //! clutch torsional damper, and takes back the gear contact's torque τ_M.
 //!
-//! - [`model`]: equations, parameters, the variable table, the model description;
-//! - [`instance`]: the slave's state machine and FMU state, free of C types;
-//! - `fmi2`: the C exports.
+//! - [`model`]: equations and parameters;
+//! - [`instance`]: the slave for fmi2-shell (its C exports, state machine and FMU state);
+//! - [`contract`]: value references and the model description, generated from
+//!   `modelDescription/Flywheel.toml`.
 
-pub mod fmi2;
+pub mod contract;
 pub mod instance;
 pub mod model;
+
+fmi2_shell::export_co_simulation!(crate::instance::Instance);

@@ -1,12 +1,12 @@
-//! Packages target/fmu/Flywheel.fmu: modelDescription.xml (written from src/model.rs) and
-//! the shared library as binaries/linux64/Flywheel.so.
+//! Packages target/fmu/Flywheel.fmu: modelDescription.xml (from the contract) and the
+//! shared library as binaries/linux64/Flywheel.so.
 //!
 //!     flywheel-package --lib target/release/libflywheel.so --out target/fmu/Flywheel.fmu
 
 use std::io::Write;
 use std::path::PathBuf;
 
-use flywheel::model::{MODEL_NAME, model_description};
+use flywheel::contract::{MODEL_DESCRIPTION_XML, MODEL_IDENTIFIER};
 use zip::write::SimpleFileOptions;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -30,9 +30,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut zip = zip::ZipWriter::new(std::fs::File::create(&out)?);
     let options = SimpleFileOptions::default().compression_method(zip::CompressionMethod::Deflated);
     zip.start_file("modelDescription.xml", options)?;
-    zip.write_all(model_description().as_bytes())?;
+    zip.write_all(MODEL_DESCRIPTION_XML.as_bytes())?;
     zip.start_file(
-        format!("binaries/linux64/{MODEL_NAME}.so"),
+        format!("binaries/linux64/{MODEL_IDENTIFIER}.so"),
         options.unix_permissions(0o755),
     )?;
     zip.write_all(&std::fs::read(&lib)?)?;
