@@ -10,7 +10,7 @@ import os
 
 from . import designs, results
 from .model import STATS_FROM
-from .worker import FMUPlugin, install_fmu, run_batch
+from .worker import FAILED, FMUPlugin, failed, install_fmu, run_batch
 from ..progress import Progress
 
 TASKS_PER_WORKER = 8  # batches per worker: balances the load and bounds what a lost worker costs
@@ -48,7 +48,7 @@ def execute(st, model, fmu_bytes, quiet=False, points=None, session=None):
     (several studies on one cluster), else one is opened for this study."""
     plan = Plan(st, model, points)
     store = results.Store(st.out)
-    done = store.done()
+    done = {pid: r for pid, r in store.done().items() if r["status"] != FAILED}
     todo, seen = [], set()
     for i, pid in enumerate(plan.ids):
         if pid not in done and pid not in seen:
@@ -141,7 +141,13 @@ class Session:
         from distributed import as_completed
 
         # a batch's key names its points: the same key on a shared cluster is the same work
-        futures = [self.client.submit(run_batch, self.model.guid, st.duration, record, b,
-                                      pure=False, key=_key(b)) for b in batches]
+        futures = {self.client.submit(run_batch, self.model.guid, st.duration, record, b,
+                                      pure=False, key=_key(b)): b for b in batches}
         for fut in as_completed(futures):
-            store_batch(fut.result())
+            try:
+                rows = fut.result()
+            except Exception as e:  # noqa: BLE001 (e.g. KilledWorker: the batch killed its
+                # workers again and again); its points are recorded, not dropped
+                rows = [{**failed(f"{type(e).__name__}: {e}"), "point": i, "point_id": pid}
+                        for i, pid, _ in futures[fut]]
+            store_batch(rows)

@@ -71,8 +71,8 @@ def doe_figures(st, table, metrics):
         other = st.ranges[(k + 1) % len(st.ranges)] if len(st.ranges) > 1 else None
         plt, fig, axes = panels(len(metrics))
         for ax, m in zip(axes, metrics):
-            sc = ax.scatter(column(table, r.name)[ok], column(table, m)[ok], s=6,
-                            c=column(table, other.name)[ok] if other else None, cmap="viridis")
+            colour = {"c": column(table, other.name)[ok], "cmap": "viridis"} if other else {}
+            sc = ax.scatter(column(table, r.name)[ok], column(table, m)[ok], s=6, **colour)
             ax.set_title(m, fontsize=9)
             ax.set_xlabel(r.name, fontsize=8)
             ax.tick_params(labelsize=7)

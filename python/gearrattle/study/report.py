@@ -35,18 +35,19 @@ def write(st, model, table, wall):
     ok = ok_rows(table)
     cpu = column(table, "cpu_s")
     files = [os.path.join(st.out, "points.parquet"), os.path.join(st.out, "points.csv")]
+    status = table.column("status").to_pylist()
     lines = [f"{st.kind} study of {st.fmu} (GUID {model.guid}): {n} points, {int(ok.sum())} ok, "
-             f"{n - int(ok.sum())} refused; {st.duration:g} s each"
+             f"{status.count('refused')} refused by the FMU, {status.count('failed')} failed "
+             f"(run again on resume); {st.duration:g} s each"
              + (f", statistics from {st.stats_from[0]:g} s" if st.stats_from else "")]
     lines.append(f"  fixed: " + (", ".join(f"{k} = {v:g}" for k, (v, _) in st.fixed.items())
                                  or "-"))
     if np.isfinite(cpu).any():
         lines.append(f"  CPU per point: median {1e3 * np.nanmedian(cpu):.2f} ms, total "
                      f"{np.nansum(cpu):.1f} s; wall {wall:.1f} s for the points run now")
-    for status, msg in sorted({(s, m) for s, m in zip(table.column("status").to_pylist(),
-                                                        table.column("message").to_pylist())
-                               if s != "ok"})[:10]:
-        lines.append(f"  {status}: {msg}")
+    for code, msg in sorted({(s, m) for s, m in zip(status, table.column("message").to_pylist())
+                             if s != "ok"})[:10]:
+        lines.append(f"  {code}: {msg}")
     metrics = [v.name for v in model.metrics] + list(st.record)
     if not metrics:
         lines.append("  this FMU has no stat_* outputs: the rows hold the parameters and status")

@@ -34,7 +34,8 @@ class Store:
         for name in sorted(os.listdir(self.partial)):
             if name.endswith(".parquet"):
                 for r in pq.read_table(os.path.join(self.partial, name)).to_pylist():
-                    rows[r["point_id"]] = r
+                    if rows.get(r["point_id"], {}).get("status") in (None, "failed"):
+                        rows[r["point_id"]] = r  # a point run again after failing
         return rows
 
     def append(self, rows, schema):

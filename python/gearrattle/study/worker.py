@@ -203,11 +203,21 @@ def run_batch(guid, duration, record, points):
             row = instance(guid).run(values, duration, record)
         except _Fatal as e:
             drop_instance(guid)
-            row = e.row
-            row["cpu_s"] = float("nan")
+            row = {**e.row, "cpu_s": float("nan")}
+        except Exception as e:  # noqa: BLE001 (the instance's state is unknown: a new one)
+            drop_instance(guid)
+            row = failed(f"{type(e).__name__}: {e}")
         row.update(point=index, point_id=pid)
         rows.append(row)
     return rows
+
+
+def failed(message):
+    """The row of a point that could not be run (not the FMU's refusal): retried on resume."""
+    return {"status": FAILED, "message": message, "cpu_s": float("nan")}
+
+
+FAILED = "failed"
 
 
 
