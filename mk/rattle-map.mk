@@ -4,6 +4,7 @@
 # `make test`. A rerun reuses the points already in target/rattle_map/{grid,threshold}.
 #   make rattle-map RATTLE_MAP_FLAGS="--A 100:700:100 --workers 4"
 #   make rattle-map RATTLE_MAP_FLAGS="--scheduler tcp://HOST:8786"   (an existing Dask cluster)
+#   make rattle-map RATTLE_MAP_FLAGS=--trajectory-stats   (+ free flights, speeds along runs: ~30 s more)
 # (options: .venv/bin/python scripts/rattle_map.py --help)
 
 RATTLE_MAP_OUT ?= target/rattle_map

@@ -34,6 +34,7 @@ import argparse
 import csv
 import math
 import os
+import shutil
 import sys
 import time
 
@@ -48,7 +49,7 @@ from matplotlib.patches import Rectangle  # noqa: E402
 from matplotlib.ticker import FuncFormatter  # noqa: E402
 
 from demo import SCENES, read_params  # noqa: E402  (reuse, no duplicate)
-from gearrattle.study import engine, spec  # noqa: E402
+from gearrattle.study import engine, sampled, spec  # noqa: E402
 from gearrattle.study.cli import prepare  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -93,6 +94,57 @@ def grid_rows(table, duration, t_from):
                 rms_accel=r["stat_a_rms"])
         rows.append(out)
     return rows
+
+
+def add_trajectory_stats(rows, fmu, workers, duration, t_from, fixed):
+    """What needs the trajectory itself (free flights, impact speeds along a run, the shortest
+    gap between impacts on one flank), from every grid point sampled every 50 us through fmpy,
+    as rattle_map did before the study runner; and whether those samples count the impacts the
+    stat_* outputs count."""
+    from fmpy import extract
+
+    ok = [r for r in rows if r["status"] == "ok"]
+    fmu_dir = extract(fmu)
+    try:
+        stats, _ = sampled.run(fmu_dir, [{**fixed, "f_exc": r["f_Hz"], "A_rms": r["A_rms"]}
+                                         for r in ok], workers or os.cpu_count() or 1,
+                               duration, t_from, trajectory=True)
+    finally:
+        shutil.rmtree(fmu_dir, ignore_errors=True)
+    for r, st in zip(ok, stats):
+        r.update({k: st[k] for k in TRAJECTORY})
+        r["sampled_counts_agree"] = int(st["impacts_Fplus"] == r["impacts_Fplus"]
+                                        and st["impacts_Fminus"] == r["impacts_Fminus"])
+
+
+def trajectory_lines(ok, p, meta):
+    """The summary's lines from --trajectory-stats."""
+    def rng(x, scale=1.0, fmt="{:.2f}"):
+        return f"{fmt.format(np.nanmin(x) * scale)}..{fmt.format(np.nanmax(x) * scale)}"
+
+    col = {k: np.array([r[k] for r in ok], dtype=float)
+           for k in TRAJECTORY + ["sampled_counts_agree"]}
+    rd, dur = col["runs_decreasing"], col["free_flight_mean_duration"]
+    decay = p["C"] / p["I_L"]
+    return [
+        "From every grid point sampled every 50 us (--trajectory-stats):",
+        f"  impact counts of the samples equal to the stat_* outputs' at "
+        f"{int(col['sampled_counts_agree'].sum())} of {len(ok)} points",
+        f"  runs of >= 2 impacts whose impact speeds decrease along the run: "
+        f"{rng(rd, 100, '{:.0f}')} % of the runs of a point; 100 % at "
+        f"{np.count_nonzero(rd == 1)} of {np.count_nonzero(np.isfinite(rd))} points",
+        f"  mean free-flight duration: {rng(dur, 1e3)} ms, i.e. the speed decays by "
+        f"{100 * (1 - np.exp(-decay * np.nanmin(dur))):.0f}.."
+        f"{100 * (1 - np.exp(-decay * np.nanmax(dur))):.0f} % over a mean flight",
+        f"  shortest time between two impacts on one flank: "
+        f"{1e3 * np.nanmin(col['min_gap_same_flank']):.2f} ms",
+        f"  free-flight speed decay rate (median per point): "
+        f"{rng(col['free_flight_decay'], fmt='{:.2f}')} 1/s (C* = C/I_L = {decay:.2f} 1/s)",
+    ] + [f"  {s['name']}: mean free flight {1e3 * r['free_flight_mean_duration']:.2f} ms (across "
+         f"the gap {1e3 * r['crossing_flight_mean_duration']:.2f}, bounces on one flank "
+         f"{1e3 * r['bounce_flight_mean_duration']:.2f}), impact speeds decreasing along "
+         f"{100 * r['runs_decreasing']:.0f} % of the runs"
+         for s in SCENES for r in ok if r["f_Hz"] == s["f"] and r["A_rms"] == s["A_rms"]]
 
 
 # --------------------------------------------------------------------------- threshold
@@ -432,7 +484,11 @@ CSV_COLS = [
     "mean_impact_speed", "mean_impact_speed_Fplus", "mean_impact_speed_Fminus",
     "max_impact_speed", "power_dissipated", "power_contact", "power_lubricant", "rms_accel",
     "cpu_s", "fmu_error",
+] + [  # with --trajectory-stats
+    "runs_decreasing", "min_gap_same_flank", "free_flight_decay", "free_flight_mean_duration",
+    "crossing_flight_mean_duration", "bounce_flight_mean_duration", "sampled_counts_agree",
 ]
+TRAJECTORY = CSV_COLS[CSV_COLS.index("runs_decreasing"):CSV_COLS.index("sampled_counts_agree")]
 
 
 def fmt_cell(v):
@@ -495,12 +551,40 @@ def summary_lines(rows, thr, fs, As, p, meta):
     L.append(f"  impacts per period (F+ + F-): {rng(ipp)}")
     L.append(f"  mean run on one flank:        {rng(run)}; longest run "
              f"{int(max(r['run_max'] for r in ok))}")
+    short = [f"{r['f_Hz']:g}/{r['A_rms']:g}" for r in ok if r["mean_run"] < 2]
+    L.append(f"  mean run < 2 at {len(short)} of {len(ok)} points (f Hz/A_rms): "
+             + (" ".join(short) or "-"))
     L.append(f"  mean impact speed:            {rng(v, fmt='{:.1f}')} mm/s")
     L.append(f"  dissipated power:             {rng(pw, 1e3, '{:.0f}')} mW, of which contact "
              f"{rng(pc / pw, 100, '{:.1f}')} % ({rng(pc, 1e3, '{:.1f}')} mW)")
     L.append(f"  RMS pitch-line acceleration:  {rng(arms, fmt='{:.1f}')} m/s^2")
     L.append(f"  |F+ - F-| / (F+ + F-) impacts: at most {100 * np.max(asym):.1f} %; above 5 % in "
              f"{np.count_nonzero(asym > 0.05)} of {len(ok)} points")
+    # where runs are long / short
+    L.append("Mean run on one flank by frequency (min..max over A_rms), grid cells with mean "
+             "run >= 3.5 / < 3.5:")
+    for fv in fs:
+        rr = np.array([r["mean_run"] for r in ok if r["f_Hz"] == fv])
+        long_ = [r["A_rms"] for r in ok if r["f_Hz"] == fv and r["mean_run"] >= 3.5]
+        L.append(f"  {fv:4g} Hz: {rng(rr)}   >= 3.5 at A_rms = "
+                 + (", ".join(f"{x:g}" for x in long_) if long_ else "-"))
+    L.append("Mean run on one flank against the main-shaft displacement amplitude on its pitch "
+             "circle, r_M sqrt(2) A_rms / (2 pi f)^2 (bins; mean, min..max over the cells):")
+    bins = [0, 50, 100, 150, 200, 250, 300, 400, 500, 1000]
+    for b0, b1 in zip(bins[:-1], bins[1:]):
+        sel = (disp >= b0) & (disp < b1)
+        if np.any(sel):
+            lo_f, hi_f = np.argmin(np.where(sel, f, np.inf)), np.argmax(np.where(sel, f, -np.inf))
+            L.append(f"  {b0:4d}-{b1:<4d} um: {np.nanmean(run[sel]):.2f} ({rng(run[sel])}, "
+                     f"{np.count_nonzero(sel):2d} cells); RMS accel {arms[lo_f]:.1f} m/s^2 at "
+                     f"{f[lo_f]:g} Hz, {arms[hi_f]:.1f} at {f[hi_f]:g} Hz")
+    parts = []
+    for Av in As:
+        x = arms[A == Av]
+        if len(x):
+            parts.append(f"{Av:g}: {rng(x, fmt='{:.1f}')}")
+    L.append("RMS pitch-line acceleration [m/s^2] over f at fixed A_rms (min..max): "
+             + "; ".join(parts))
     L.append("Paper section 9 (Spearman rank correlation over the grid):")
     L.append(f"  mean run vs main-shaft displacement amplitude {spearman(disp, run):+.2f}, "
              f"vs A_rms {spearman(A, run):+.2f}")
@@ -520,6 +604,8 @@ def summary_lines(rows, thr, fs, As, p, meta):
         if not meta["set"]:  # the references hold for the paper's parameters only
             L.append(f"      model reference: {s['model_ref']}")
         L.append(f"      paper (measured): {s['paper']}")
+    if "free_flight_decay" in ok[0]:
+        L += trajectory_lines(ok, p, meta)
     if thr:
         L.append("No-impact threshold (A_rms in rad/s^2 RMS; [lo, hi] brackets of the bisection):")
         L.append(f"  {'f Hz':>5}  {'A_first':>16}  {'A_sustained':>16}  isolated sustaining "
@@ -576,6 +662,11 @@ def main(argv=None):
                     help="override a parameter's start value (repeatable), e.g. --set G=80e-6; "
                          "the default is the paper's parameters")
     ap.add_argument("--no-threshold", action="store_true", help="skip the threshold search")
+    ap.add_argument("--trajectory-stats", action="store_true",
+                    help="also sample every grid point every 50 us through fmpy (as before the "
+                         "study runner: about 30 s more on 2 cores) for the statistics that need "
+                         "the trajectory: free flights, impact speeds along a run, the shortest "
+                         "gap between two impacts on one flank")
     ap.add_argument("--threshold-duration", type=float, default=1.0)
     ap.add_argument("--threshold-window", type=float, default=0.4)
     ap.add_argument("--threshold-tol", type=float, default=0.005,
@@ -619,6 +710,9 @@ def main(argv=None):
                              os.path.join(args.out, "threshold"))
     wall = time.perf_counter() - t_all
     rows = grid_rows(table, args.duration, args.t_from)
+    if args.trajectory_stats:
+        add_trajectory_stats(rows, args.fmu, args.workers, args.duration, args.t_from,
+                             {k: v for k, (v, _) in grid.fixed.items()})
     os.makedirs(args.out, exist_ok=True)
     files = [write_grid_csv(rows, os.path.join(args.out, "rattle_map.csv"))]
     if thr:

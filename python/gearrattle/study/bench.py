@@ -19,7 +19,6 @@ with the machine and the commands, to --report (docs/STUDY_BENCH.md) and a figur
 5. Throughput (points per second, cluster already up) with 2 workers against 1."""
 
 import argparse
-import multiprocessing as mp
 import os
 import platform
 import resource
@@ -65,25 +64,11 @@ def grid_values(x, y):
         "gearrattle.study.designs", fromlist=["points"]).points(st)]
 
 
-_W = {}
-
-
-def _init(fmu_dir):
-    from fmpy import read_model_description
-
-    _W["dir"], _W["md"] = fmu_dir, read_model_description(fmu_dir)
-
-
-def _sampled(values):
-    return sampled.point(_W["dir"], _W["md"], values, DURATION, T_FROM)
-
-
 def today(fmu_dir, points, workers):
     """Today's engine over the points on `workers` processes: (statistics, CPU s, wall s)."""
     t0 = time.perf_counter()
-    with mp.get_context("fork").Pool(workers, initializer=_init, initargs=(fmu_dir,)) as pool:
-        res = pool.map(_sampled, points, chunksize=4)
-    return [r[0] for r in res], np.array([r[1] for r in res]), time.perf_counter() - t0
+    stats, cpu = sampled.run(fmu_dir, points, workers, DURATION, T_FROM)
+    return stats, np.array(cpu), time.perf_counter() - t0
 
 
 def from_c(fmu, fmu_dir, model, table, params, metrics, tmp):
