@@ -23,6 +23,11 @@ Two levels per frequency:
                near the onset); they are listed in threshold.csv and marked on the plot.
 A level the FMU refuses is reported with the FMU's message and ends that bisection.
 
+--trajectory-stats adds what only the trajectory shows (free flights and their decay, impact
+speeds along a run, the shortest gap between two impacts on one flank): every grid point is also
+sampled every 50 us through fmpy, as before the study runner, and its impact counts checked
+against the stat_* outputs'.
+
 Outputs (in --out, default target/rattle_map): rattle_map.csv, threshold.csv, summary.txt,
 map_impacts_per_period.png, map_mean_run.png, map_impact_speed.png, map_power.png,
 map_overview.png, threshold.png, collapse.png (the paper's section 9 claims: runs vs
