@@ -10,7 +10,8 @@
 //! - [`rattle`]: the gear pair as a piecewise ODE for the integrator, with impact counting
 //!   (the shaft's motion imposed; [`rattle::torque`]: driven by a torque, 7 states);
 //! - [`instance`]: the co-simulation slave (FMI state machine, variables, stepping);
-//! - the `fmi2*` C exports: [`fmi2_shell`]'s, around [`instance::Instance`];
+//! - the `fmi2*` C exports of Co-Simulation and Model Exchange: [`fmi2_shell`]'s, around
+//!   [`instance::Instance`];
 //! - [`contract`]: value references and the model description, generated from
 //!   `modelDescription/GearRattle.toml`.
 
@@ -23,3 +24,4 @@ pub mod physics;
 pub mod rattle;
 
 fmi2_shell::export_co_simulation!(crate::instance::Instance);
+fmi2_shell::export_model_exchange!(crate::instance::Instance);

@@ -69,6 +69,8 @@ fn only_the_fmi2_functions_are_exported() {
         "fmi2DoStep",
         "fmi2GetFMUstate",
         "fmi2SetRealInputDerivatives",
+        "fmi2GetDerivatives",
+        "fmi2NewDiscreteStates",
     ] {
         assert!(symbols.contains(&f), "{f} is not exported");
     }

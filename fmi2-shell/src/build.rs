@@ -19,6 +19,8 @@ use std::{env, fs, path::PathBuf};
 struct Contract {
     model: Model,
     capabilities: BTreeMap<String, toml::Value>,
+    /// Model Exchange's capabilities, where the model offers it.
+    model_exchange: Option<BTreeMap<String, toml::Value>>,
     experiment: BTreeMap<String, f64>,
     log_categories: Vec<(String, String)>,
     unit: Vec<Unit>,
@@ -32,6 +34,9 @@ struct Model {
     description: String,
     version: String,
     author: String,
+    /// Number of event indicators (Model Exchange).
+    #[serde(default)]
+    event_indicators: usize,
 }
 
 #[derive(Deserialize)]
@@ -65,6 +70,9 @@ struct Variable {
     /// The FMU gives this output's first time derivative (fmi2GetRealOutputDerivatives).
     #[serde(default)]
     derivative: bool,
+    /// Model Exchange: this variable is the time derivative of the continuous state named
+    /// here; the order of these variables is the order of the state vector.
+    derivative_of: Option<String>,
 }
 
 impl Variable {
@@ -101,7 +109,7 @@ fn check(c: &Contract) {
             v.ty
         );
         assert!(
-            ["parameter", "input", "output"].contains(&v.causality.as_str()),
+            ["parameter", "input", "output", "local"].contains(&v.causality.as_str()),
             "{}: unknown causality {}",
             v.name,
             v.causality
@@ -113,7 +121,7 @@ fn check(c: &Contract) {
             v.ty
         );
         assert!(
-            v.causality == "output" || v.start.is_some(),
+            ["output", "local"].contains(&v.causality.as_str()) || v.start.is_some(),
             "{}: parameters and inputs need a start value",
             v.name
         );
@@ -129,6 +137,15 @@ fn check(c: &Contract) {
             "{}: only Real outputs have derivatives",
             v.name
         );
+        if let Some(state) = &v.derivative_of {
+            assert!(
+                c.variable
+                    .iter()
+                    .any(|w| &w.name == state && w.ty == "Real"),
+                "{}: derivative of {state}, which is not a Real variable",
+                v.name
+            );
+        }
         for d in v.depends_on.iter().flatten() {
             assert!(
                 c.variable
@@ -159,6 +176,21 @@ fn guid_of(text: &str) -> String {
     )
 }
 
+/// A variable's name as a Rust identifier: "der(xi)" is `der_xi`.
+fn ident(name: &str) -> String {
+    let mangled: String = name
+        .chars()
+        .map(|ch| {
+            if ch.is_alphanumeric() || ch == '_' {
+                ch
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    mangled.trim_end_matches('_').to_string()
+}
+
 fn esc(s: &str) -> String {
     s.replace('&', "&amp;")
         .replace('<', "&lt;")
@@ -179,16 +211,25 @@ fn value(v: &toml::Value) -> String {
 fn xml(c: &Contract, guid: &str) -> String {
     let mut x = String::new();
     let m = &c.model;
+    let index_of = |name: &str| 1 + c.variable.iter().position(|w| w.name == name).unwrap();
     x += "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
     writeln!(
         x,
-        "<fmiModelDescription fmiVersion=\"2.0\" modelName=\"{}\" guid=\"{guid}\" description=\"{}\" author=\"{}\" version=\"{}\" generationTool=\"fmi2-shell\" variableNamingConvention=\"flat\" numberOfEventIndicators=\"0\">",
+        "<fmiModelDescription fmiVersion=\"2.0\" modelName=\"{}\" guid=\"{guid}\" description=\"{}\" author=\"{}\" version=\"{}\" generationTool=\"fmi2-shell\" variableNamingConvention=\"flat\" numberOfEventIndicators=\"{}\">",
         esc(&m.name),
         esc(&m.description),
         esc(&m.author),
-        esc(&m.version)
+        esc(&m.version),
+        m.event_indicators
     )
     .unwrap();
+    if let Some(caps) = &c.model_exchange {
+        write!(x, "  <ModelExchange modelIdentifier=\"{}\"", m.identifier).unwrap();
+        for (k, v) in caps {
+            write!(x, " {k}=\"{}\"", value(v)).unwrap();
+        }
+        x += "/>\n";
+    }
     write!(x, "  <CoSimulation modelIdentifier=\"{}\"", m.identifier).unwrap();
     for (k, v) in &c.capabilities {
         write!(x, " {k}=\"{}\"", value(v)).unwrap();
@@ -256,10 +297,12 @@ fn xml(c: &Contract, guid: &str) -> String {
         if let Some(b) = &v.max {
             write!(x, " max=\"{}\"", value(b)).unwrap();
         }
+        if let Some(state) = &v.derivative_of {
+            write!(x, " derivative=\"{}\"", index_of(state)).unwrap();
+        }
         x += "/>\n    </ScalarVariable>\n";
     }
     x += "  </ModelVariables>\n  <ModelStructure>\n    <Outputs>\n";
-    let index_of = |name: &str| 1 + c.variable.iter().position(|w| w.name == name).unwrap();
     let outputs: Vec<_> = (1..)
         .zip(&c.variable)
         .filter(|(_, v)| v.causality == "output")
@@ -283,8 +326,26 @@ fn xml(c: &Contract, guid: &str) -> String {
             .unwrap();
         }
     }
-    x += "    </Outputs>\n    <InitialUnknowns>\n";
-    for (i, _) in &outputs {
+    x += "    </Outputs>\n";
+    // Model Exchange: the state derivatives, in the order of the state vector (each depends
+    // on every state and input: no dependencies are declared).
+    let derivatives: Vec<usize> = (1..)
+        .zip(&c.variable)
+        .filter(|(_, v)| v.derivative_of.is_some())
+        .map(|(i, _)| i)
+        .collect();
+    if !derivatives.is_empty() {
+        x += "    <Derivatives>\n";
+        for i in &derivatives {
+            writeln!(x, "      <Unknown index=\"{i}\"/>").unwrap();
+        }
+        x += "    </Derivatives>\n";
+    }
+    x += "    <InitialUnknowns>\n";
+    let mut initial: Vec<usize> = outputs.iter().map(|(i, _)| *i).collect();
+    initial.extend(&derivatives);
+    initial.sort();
+    for i in initial {
         writeln!(x, "      <Unknown index=\"{i}\"/>").unwrap();
     }
     x += "    </InitialUnknowns>\n  </ModelStructure>\n</fmiModelDescription>\n";
@@ -315,7 +376,7 @@ fn rust(c: &Contract, guid: &str) -> String {
     }
     r += "}\n\n/// Value references, named as the variables.\n#[allow(non_upper_case_globals)]\npub mod vr {\n";
     for v in &c.variable {
-        writeln!(r, "    pub const {}: u32 = {};", v.name, v.vr).unwrap();
+        writeln!(r, "    pub const {}: u32 = {};", ident(&v.name), v.vr).unwrap();
     }
     r += "}\n\n/// Every variable of the contract, in the order of the model description.\npub static VARIABLES: &[Variable] = &[\n";
     for v in &c.variable {
@@ -331,6 +392,7 @@ fn rust(c: &Contract, guid: &str) -> String {
         };
         let causality = match &v.causality[..] {
             "parameter" => "Parameter",
+            "local" => "Local",
             "input" => "Input",
             _ => "Output",
         };
@@ -347,7 +409,32 @@ fn rust(c: &Contract, guid: &str) -> String {
         )
         .unwrap();
     }
-    r += "];\n\n/// Index in VARIABLES of the variable of a kind and value reference (a jump table, not\n/// a search: fmi2GetReal looks every reference up).\npub fn index(kind: Kind, vr: u32) -> Option<usize> {\n    match (kind, vr) {\n";
+    r += "];\n\n";
+    let derivatives: Vec<&Variable> = c
+        .variable
+        .iter()
+        .filter(|v| v.derivative_of.is_some())
+        .collect();
+    let vr_of = |name: &str| c.variable.iter().find(|w| w.name == name).unwrap().vr;
+    writeln!(
+        r,
+        "/// Model Exchange: the continuous states' value references, in the state vector's order.\npub const STATES: &[u32] = &{:?};",
+        derivatives.iter().map(|v| vr_of(v.derivative_of.as_deref().unwrap())).collect::<Vec<_>>()
+    )
+    .unwrap();
+    writeln!(
+        r,
+        "/// Model Exchange: their derivatives' value references.\npub const DERIVATIVES: &[u32] = &{:?};",
+        derivatives.iter().map(|v| v.vr).collect::<Vec<_>>()
+    )
+    .unwrap();
+    writeln!(
+        r,
+        "pub const EVENT_INDICATORS: usize = {};\n",
+        c.model.event_indicators
+    )
+    .unwrap();
+    r += "/// Index in VARIABLES of the variable of a kind and value reference (a jump table, not\n/// a search: fmi2GetReal looks every reference up).\npub fn index(kind: Kind, vr: u32) -> Option<usize> {\n    match (kind, vr) {\n";
     for (i, v) in c.variable.iter().enumerate() {
         writeln!(r, "        (Kind::{}, {}) => Some({i}),", v.ty, v.vr).unwrap();
     }

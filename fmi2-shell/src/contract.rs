@@ -16,6 +16,9 @@ pub enum Causality {
     Input,
     /// Computed by the FMU, read-only.
     Output,
+    /// Computed by the FMU, read-only, not meant for connections: the continuous states
+    /// and their derivatives of Model Exchange that are not outputs.
+    Local,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]

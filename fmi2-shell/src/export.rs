@@ -7,7 +7,7 @@
 use crate::component::{Component, guard, slice, slice_mut};
 use crate::fmu_state::{self, deserialize, serialize};
 use crate::logger::Logger;
-use crate::slave::{Slave, reset, restore, snapshot};
+use crate::slave::{Interface, Slave, reset, restore, snapshot};
 use crate::state::allowed;
 use crate::status::{FmiError, FmiResult, Status};
 use fmi_sys::fmi2::*;
@@ -32,18 +32,26 @@ pub fn version() -> *const c_char {
     c"2.0".as_ptr()
 }
 
-/// Reasons fmi2Instantiate refuses, checked before anything is allocated.
-unsafe fn check_instantiate<S: Slave>(fmu_type: fmi2Type, guid: fmi2String) -> FmiResult {
+/// The interface fmi2Instantiate asks for, or the reason it refuses, checked before anything
+/// is allocated.
+unsafe fn check_instantiate<S: Slave>(
+    fmu_type: fmi2Type,
+    guid: fmi2String,
+) -> FmiResult<Interface> {
     let id = &S::IDENTITY;
-    if fmu_type != fmi2Type_fmi2CoSimulation {
-        return Err(FmiError::error(format!(
-            "{} is a Co-Simulation FMU only (fmuType = {fmu_type} requested)",
-            id.model_identifier
-        )));
-    }
+    let interface = match fmu_type {
+        t if t == fmi2Type_fmi2CoSimulation => Interface::CoSimulation,
+        t if t == fmi2Type_fmi2ModelExchange && id.model_exchange => Interface::ModelExchange,
+        _ => {
+            return Err(FmiError::error(format!(
+                "{} does not offer fmuType = {fmu_type} (0 Model Exchange, 1 Co-Simulation)",
+                id.model_identifier
+            )));
+        }
+    };
     // SAFETY: the importer's string argument.
     match unsafe { text(guid) } {
-        Some(guid) if guid == id.guid => Ok(()),
+        Some(guid) if guid == id.guid => Ok(interface),
         other => Err(FmiError::error(format!(
             "GUID {other:?} does not match this binary's {}: the model description and the binary are from different builds",
             id.guid
@@ -83,12 +91,15 @@ pub unsafe fn instantiate<S: Slave>(
             return std::ptr::null_mut();
         }
         // SAFETY: the importer's arguments.
-        if let Err(e) = unsafe { check_instantiate::<S>(fmu_type, guid) } {
-            logger.log(e.status, error, &format!("fmi2Instantiate: {}", e.message));
-            return std::ptr::null_mut();
-        }
+        let interface = match unsafe { check_instantiate::<S>(fmu_type, guid) } {
+            Ok(interface) => interface,
+            Err(e) => {
+                logger.log(e.status, error, &format!("fmi2Instantiate: {}", e.message));
+                return std::ptr::null_mut();
+            }
+        };
         let component = Box::new(Component {
-            slave: S::new(logging_on != 0),
+            slave: S::new(logging_on != 0, interface),
             logger,
         });
         Box::into_raw(component) as fmi2Component
@@ -471,6 +482,111 @@ pub unsafe fn get_real_output_derivatives<S: Slave>(
                 )
             };
             s.get_output_derivatives(vr, order, out)
+        },
+    )
+}
+
+// Model Exchange.
+
+pub fn set_time<S: Slave>(c: fmi2Component, t: fmi2Real) -> fmi2Status {
+    guard(c, "fmi2SetTime", allowed::SET_TIME, |s: &mut S| {
+        s.set_time(t)
+    })
+}
+
+pub unsafe fn set_continuous_states<S: Slave>(
+    c: fmi2Component,
+    x: *const fmi2Real,
+    n: usize,
+) -> fmi2Status {
+    guard(
+        c,
+        "fmi2SetContinuousStates",
+        allowed::SET_CONTINUOUS_STATES,
+        |s: &mut S| {
+            // SAFETY: the importer's array of n elements.
+            s.set_continuous_states(unsafe { slice(x, n, "x") }?)
+        },
+    )
+}
+
+/// fmi2GetDerivatives, fmi2GetEventIndicators, fmi2GetContinuousStates and
+/// fmi2GetNominalsOfContinuousStates: an array of n values the slave fills.
+pub unsafe fn get_vector<S: Slave>(
+    c: fmi2Component,
+    function: &str,
+    out: *mut fmi2Real,
+    n: usize,
+    get: impl FnOnce(&mut S, &mut [f64]) -> FmiResult,
+) -> fmi2Status {
+    guard(c, function, allowed::GET_CONTINUOUS, |s: &mut S| {
+        // SAFETY: the importer's array of n elements.
+        get(s, unsafe { slice_mut(out, n, "the output array") }?)
+    })
+}
+
+pub fn enter_event_mode<S: Slave>(c: fmi2Component) -> fmi2Status {
+    guard(
+        c,
+        "fmi2EnterEventMode",
+        allowed::ENTER_EVENT_MODE,
+        S::enter_event_mode,
+    )
+}
+
+pub unsafe fn new_discrete_states<S: Slave>(
+    c: fmi2Component,
+    info: *mut fmi2EventInfo,
+) -> fmi2Status {
+    guard(
+        c,
+        "fmi2NewDiscreteStates",
+        allowed::NEW_DISCRETE_STATES,
+        |s: &mut S| {
+            // SAFETY: the importer's struct, or NULL (refused).
+            let Some(out) = (unsafe { info.as_mut() }) else {
+                return Err(FmiError::error("fmi2EventInfo is NULL"));
+            };
+            let e = s.new_discrete_states()?;
+            out.newDiscreteStatesNeeded = e.new_discrete_states_needed.into();
+            out.terminateSimulation = e.terminate_simulation.into();
+            out.nominalsOfContinuousStatesChanged = e.nominals_of_continuous_states_changed.into();
+            out.valuesOfContinuousStatesChanged = e.values_of_continuous_states_changed.into();
+            out.nextEventTimeDefined = e.next_event_time.is_some().into();
+            out.nextEventTime = e.next_event_time.unwrap_or(0.0);
+            Ok(())
+        },
+    )
+}
+
+pub fn enter_continuous_time_mode<S: Slave>(c: fmi2Component) -> fmi2Status {
+    guard(
+        c,
+        "fmi2EnterContinuousTimeMode",
+        allowed::ENTER_CONTINUOUS_TIME_MODE,
+        S::enter_continuous_time_mode,
+    )
+}
+
+pub unsafe fn completed_integrator_step<S: Slave>(
+    c: fmi2Component,
+    enter_event_mode: *mut fmi2Boolean,
+    terminate: *mut fmi2Boolean,
+) -> fmi2Status {
+    guard(
+        c,
+        "fmi2CompletedIntegratorStep",
+        allowed::COMPLETED_INTEGRATOR_STEP,
+        |s: &mut S| {
+            let event = s.completed_integrator_step()?;
+            // SAFETY: the importer's pointers to one value each, or NULL (then not written).
+            if let Some(out) = unsafe { enter_event_mode.as_mut() } {
+                *out = event.into();
+            }
+            if let Some(out) = unsafe { terminate.as_mut() } {
+                *out = 0;
+            }
+            Ok(())
         },
     )
 }

@@ -35,6 +35,6 @@ pub mod values;
 #[cfg(feature = "runtime")]
 pub use fmi_sys::fmi2;
 pub use log::{Log, Message};
-pub use slave::{Identity, Slave};
+pub use slave::{EventInfo, Identity, Interface, Slave};
 pub use state::FmiState;
 pub use status::{FmiError, FmiResult, Status};

@@ -1,4 +1,5 @@
-//! [`export_co_simulation!`](crate::export_co_simulation): the exported `fmi2*` symbols of a
+//! [`export_co_simulation!`](crate::export_co_simulation) and
+//! [`export_model_exchange!`](crate::export_model_exchange): the exported `fmi2*` symbols of a
 //! model's cdylib, each a one-line call of the generic body in [`export`](crate::export).
 
 /// Exports every function of FMI 2.0 Co-Simulation for the slave type `$slave` (importers
@@ -323,6 +324,117 @@ macro_rules! export_co_simulation {
                 value: *mut fmi2Real,
             ) -> fmi2Status {
                 unsafe { e::get_real_output_derivatives::<S>(c, vr, nvr, order, value) }
+            }
+        }
+    };
+}
+
+/// Exports the functions of FMI 2.0 Model Exchange for the slave type `$slave`, beside
+/// those of [`export_co_simulation!`] (invoke both, once each, in the model's cdylib).
+#[macro_export]
+macro_rules! export_model_exchange {
+    ($slave:ty) => {
+        mod fmi2_model_exchange_exports {
+            #![allow(non_snake_case, clippy::missing_safety_doc)]
+            use super::*;
+            use $crate::export as e;
+            use $crate::fmi2::*;
+            use $crate::slave::Slave as _;
+            type S = $slave;
+
+            #[unsafe(no_mangle)]
+            pub extern "C" fn fmi2SetTime(c: fmi2Component, time: fmi2Real) -> fmi2Status {
+                e::set_time::<S>(c, time)
+            }
+            #[unsafe(no_mangle)]
+            pub unsafe extern "C" fn fmi2SetContinuousStates(
+                c: fmi2Component,
+                x: *const fmi2Real,
+                nx: usize,
+            ) -> fmi2Status {
+                unsafe { e::set_continuous_states::<S>(c, x, nx) }
+            }
+            #[unsafe(no_mangle)]
+            pub extern "C" fn fmi2EnterEventMode(c: fmi2Component) -> fmi2Status {
+                e::enter_event_mode::<S>(c)
+            }
+            #[unsafe(no_mangle)]
+            pub unsafe extern "C" fn fmi2NewDiscreteStates(
+                c: fmi2Component,
+                info: *mut fmi2EventInfo,
+            ) -> fmi2Status {
+                unsafe { e::new_discrete_states::<S>(c, info) }
+            }
+            #[unsafe(no_mangle)]
+            pub extern "C" fn fmi2EnterContinuousTimeMode(c: fmi2Component) -> fmi2Status {
+                e::enter_continuous_time_mode::<S>(c)
+            }
+            #[unsafe(no_mangle)]
+            pub unsafe extern "C" fn fmi2CompletedIntegratorStep(
+                c: fmi2Component,
+                _noSetFMUStatePriorToCurrentPoint: fmi2Boolean,
+                enterEventMode: *mut fmi2Boolean,
+                terminateSimulation: *mut fmi2Boolean,
+            ) -> fmi2Status {
+                unsafe { e::completed_integrator_step::<S>(c, enterEventMode, terminateSimulation) }
+            }
+            #[unsafe(no_mangle)]
+            pub unsafe extern "C" fn fmi2GetDerivatives(
+                c: fmi2Component,
+                derivatives: *mut fmi2Real,
+                nx: usize,
+            ) -> fmi2Status {
+                unsafe {
+                    e::get_vector::<S>(c, "fmi2GetDerivatives", derivatives, nx, S::get_derivatives)
+                }
+            }
+            #[unsafe(no_mangle)]
+            pub unsafe extern "C" fn fmi2GetEventIndicators(
+                c: fmi2Component,
+                eventIndicators: *mut fmi2Real,
+                ni: usize,
+            ) -> fmi2Status {
+                unsafe {
+                    e::get_vector::<S>(
+                        c,
+                        "fmi2GetEventIndicators",
+                        eventIndicators,
+                        ni,
+                        S::get_event_indicators,
+                    )
+                }
+            }
+            #[unsafe(no_mangle)]
+            pub unsafe extern "C" fn fmi2GetContinuousStates(
+                c: fmi2Component,
+                x: *mut fmi2Real,
+                nx: usize,
+            ) -> fmi2Status {
+                unsafe {
+                    e::get_vector::<S>(
+                        c,
+                        "fmi2GetContinuousStates",
+                        x,
+                        nx,
+                        S::get_continuous_states,
+                    )
+                }
+            }
+            #[unsafe(no_mangle)]
+            pub unsafe extern "C" fn fmi2GetNominalsOfContinuousStates(
+                c: fmi2Component,
+                x_nominal: *mut fmi2Real,
+                nx: usize,
+            ) -> fmi2Status {
+                unsafe {
+                    e::get_vector::<S>(
+                        c,
+                        "fmi2GetNominalsOfContinuousStates",
+                        x_nominal,
+                        nx,
+                        S::get_nominals_of_continuous_states,
+                    )
+                }
             }
         }
     };

@@ -1,12 +1,13 @@
-//! What a model gives the shell: a co-simulation slave as a typed Rust value, free of C
-//! types. The shell's C exports check the state machine, unpack the arguments, call these
-//! methods, and turn their results into statuses and log lines.
+//! What a model gives the shell: an FMU instance as a typed Rust value, free of C types, for
+//! Co-Simulation and, where the model offers it, Model Exchange. The shell's C exports check
+//! the state machine, unpack the arguments, call these methods, and turn their results into
+//! statuses and log lines.
 
 use crate::log::{Categories, Log};
 use crate::state::FmiState;
 use crate::status::{FmiError, FmiResult};
-use serde::Serialize;
 use serde::de::DeserializeOwned;
+use serde::{Deserialize, Serialize};
 
 /// Who a model is: what fmi2Instantiate checks and what tags its FMU states.
 pub struct Identity {
@@ -19,14 +20,41 @@ pub struct Identity {
     /// slave's serialized shape changes).
     pub state_magic: [u8; 4],
     pub state_version: u16,
+    /// Whether the model offers Model Exchange besides Co-Simulation.
+    pub model_exchange: bool,
+}
+
+/// The interface an instance was instantiated for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Interface {
+    CoSimulation,
+    ModelExchange,
+}
+
+/// What fmi2NewDiscreteStates reports.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct EventInfo {
+    /// Another round of fmi2NewDiscreteStates is needed at this time.
+    pub new_discrete_states_needed: bool,
+    pub terminate_simulation: bool,
+    pub nominals_of_continuous_states_changed: bool,
+    pub values_of_continuous_states_changed: bool,
+    /// The next time event, if any.
+    pub next_event_time: Option<f64>,
 }
 
 /// A co-simulation slave. Everything but its [`Log`] is its FMU state (clone and serde).
 pub trait Slave: Clone + Serialize + DeserializeOwned {
     const IDENTITY: Identity;
 
-    /// A fresh instance (state Instantiated, start values), logging as `logging_on` says.
-    fn new(logging_on: bool) -> Self;
+    /// A fresh instance for `interface` (state Instantiated, start values), logging as
+    /// `logging_on` says.
+    fn new(logging_on: bool, interface: Interface) -> Self;
+
+    /// The interface it was instantiated for.
+    fn interface(&self) -> Interface {
+        Interface::CoSimulation
+    }
 
     fn log(&mut self) -> &mut Log;
 
@@ -79,6 +107,49 @@ pub trait Slave: Clone + Serialize + DeserializeOwned {
     ) -> FmiResult {
         Err(unsupported("fmi2GetDirectionalDerivative"))
     }
+
+    // Model Exchange (offered where `IDENTITY.model_exchange`).
+
+    fn set_time(&mut self, _t: f64) -> FmiResult {
+        Err(unsupported("fmi2SetTime"))
+    }
+
+    fn set_continuous_states(&mut self, _x: &[f64]) -> FmiResult {
+        Err(unsupported("fmi2SetContinuousStates"))
+    }
+
+    fn get_continuous_states(&mut self, _x: &mut [f64]) -> FmiResult {
+        Err(unsupported("fmi2GetContinuousStates"))
+    }
+
+    fn get_nominals_of_continuous_states(&mut self, _x: &mut [f64]) -> FmiResult {
+        Err(unsupported("fmi2GetNominalsOfContinuousStates"))
+    }
+
+    fn get_derivatives(&mut self, _dx: &mut [f64]) -> FmiResult {
+        Err(unsupported("fmi2GetDerivatives"))
+    }
+
+    fn get_event_indicators(&mut self, _z: &mut [f64]) -> FmiResult {
+        Err(unsupported("fmi2GetEventIndicators"))
+    }
+
+    fn enter_event_mode(&mut self) -> FmiResult {
+        Err(unsupported("fmi2EnterEventMode"))
+    }
+
+    fn new_discrete_states(&mut self) -> FmiResult<EventInfo> {
+        Err(unsupported("fmi2NewDiscreteStates"))
+    }
+
+    fn enter_continuous_time_mode(&mut self) -> FmiResult {
+        Err(unsupported("fmi2EnterContinuousTimeMode"))
+    }
+
+    /// fmi2CompletedIntegratorStep: whether the importer must enter event mode now.
+    fn completed_integrator_step(&mut self) -> FmiResult<bool> {
+        Err(unsupported("fmi2CompletedIntegratorStep"))
+    }
 }
 
 /// The error of a function the model's capabilities do not declare.
@@ -104,5 +175,6 @@ pub fn restore<S: Slave>(slave: &mut S, saved: &S) {
 
 /// fmi2Reset: back to the state after instantiation, the logging settings kept.
 pub fn reset<S: Slave>(slave: &mut S) {
-    restore(slave, &S::new(false));
+    let interface = slave.interface();
+    restore(slave, &S::new(false, interface));
 }

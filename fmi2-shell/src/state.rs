@@ -1,6 +1,7 @@
-//! The FMI 2.0 Co-Simulation state machine: the states an instance can be in, and for each
-//! function, in one table, the states in which it may be called (as in the Reference-FMUs).
-//! A call outside them is refused with "illegal call sequence" and not executed.
+//! The FMI 2.0 state machines of Co-Simulation and Model Exchange: the states an instance can
+//! be in, and for each function, in one table, the states in which it may be called (as in
+//! the Reference-FMUs). A call outside them is refused with "illegal call sequence" and not
+//! executed.
 
 use serde::{Deserialize, Serialize};
 
@@ -8,8 +9,12 @@ use serde::{Deserialize, Serialize};
 pub enum FmiState {
     Instantiated,
     InitializationMode,
-    /// Initialised and ready for fmi2DoStep (FMI's "stepComplete").
+    /// Co-Simulation: initialised and ready for fmi2DoStep (FMI's "stepComplete").
     StepComplete,
+    /// Model Exchange: discrete states may change (after initialisation and at events).
+    EventMode,
+    /// Model Exchange: the importer integrates the continuous states.
+    ContinuousTimeMode,
     Terminated,
     /// A step failed (or a panic was caught): only inspection, reset and free remain.
     Error,
@@ -18,11 +23,13 @@ pub enum FmiState {
 impl FmiState {
     fn bit(self) -> u8 {
         match self {
-            FmiState::Instantiated => 1,
-            FmiState::InitializationMode => 2,
-            FmiState::StepComplete => 4,
-            FmiState::Terminated => 8,
-            FmiState::Error => 16,
+            FmiState::Instantiated => INSTANTIATED,
+            FmiState::InitializationMode => INITIALIZATION,
+            FmiState::StepComplete => STEP_COMPLETE,
+            FmiState::EventMode => EVENT,
+            FmiState::ContinuousTimeMode => CONTINUOUS,
+            FmiState::Terminated => TERMINATED,
+            FmiState::Error => ERROR,
         }
     }
 
@@ -30,14 +37,22 @@ impl FmiState {
     pub fn allows(self, mask: u8) -> bool {
         mask & self.bit() != 0
     }
+
+    /// Whether fmi2ExitInitializationMode has passed (the parameters are fixed).
+    pub fn is_initialised(self) -> bool {
+        !matches!(self, FmiState::Instantiated | FmiState::InitializationMode)
+    }
 }
 
 const INSTANTIATED: u8 = 1;
 const INITIALIZATION: u8 = 2;
 const STEP_COMPLETE: u8 = 4;
-const TERMINATED: u8 = 8;
-const ERROR: u8 = 16;
-const ANY: u8 = INSTANTIATED | INITIALIZATION | STEP_COMPLETE | TERMINATED | ERROR;
+const EVENT: u8 = 8;
+const CONTINUOUS: u8 = 16;
+const TERMINATED: u8 = 32;
+const ERROR: u8 = 64;
+const RUNNING: u8 = STEP_COMPLETE | EVENT | CONTINUOUS;
+const ANY: u8 = INSTANTIATED | INITIALIZATION | RUNNING | TERMINATED | ERROR;
 
 /// States in which each FMI function may be called.
 pub mod allowed {
@@ -46,14 +61,24 @@ pub mod allowed {
     pub const SETUP_EXPERIMENT: u8 = INSTANTIATED;
     pub const ENTER_INITIALIZATION_MODE: u8 = INSTANTIATED;
     pub const EXIT_INITIALIZATION_MODE: u8 = INITIALIZATION;
-    pub const TERMINATE: u8 = STEP_COMPLETE | ERROR;
+    pub const TERMINATE: u8 = RUNNING | ERROR;
     pub const RESET: u8 = ANY;
-    pub const GET: u8 = INITIALIZATION | STEP_COMPLETE | TERMINATED | ERROR;
-    pub const SET: u8 = INSTANTIATED | INITIALIZATION | STEP_COMPLETE;
+    pub const GET: u8 = INITIALIZATION | RUNNING | TERMINATED | ERROR;
+    pub const SET: u8 = INSTANTIATED | INITIALIZATION | RUNNING;
     pub const DO_STEP: u8 = STEP_COMPLETE;
     pub const GET_STATUS: u8 = STEP_COMPLETE | TERMINATED | ERROR;
     /// No asynchronous step is ever pending, so there is never one to cancel.
     pub const CANCEL_STEP: u8 = 0;
     /// fmi2Get/Set/Free/(De)SerializeFMUstate: in every state after instantiation.
     pub const FMU_STATE: u8 = ANY;
+    // Model Exchange.
+    pub const SET_TIME: u8 = EVENT | CONTINUOUS;
+    pub const SET_CONTINUOUS_STATES: u8 = CONTINUOUS;
+    /// fmi2GetDerivatives, fmi2GetEventIndicators, fmi2GetContinuousStates,
+    /// fmi2GetNominalsOfContinuousStates.
+    pub const GET_CONTINUOUS: u8 = INITIALIZATION | EVENT | CONTINUOUS | TERMINATED | ERROR;
+    pub const ENTER_EVENT_MODE: u8 = EVENT | CONTINUOUS;
+    pub const NEW_DISCRETE_STATES: u8 = EVENT;
+    pub const ENTER_CONTINUOUS_TIME_MODE: u8 = EVENT;
+    pub const COMPLETED_INTEGRATOR_STEP: u8 = CONTINUOUS;
 }

@@ -3,6 +3,7 @@
 //! with its reason; the shell checks the state machine before calling in and turns the
 //! results into fmi2Status and log lines.
 
+pub mod model_exchange;
 pub mod simulation;
 
 pub use fmi2_shell::{FmiError, FmiResult, FmiState, Status};
@@ -12,7 +13,8 @@ use crate::contract::{self, Causality, Kind, LOG_CATEGORIES, vr};
 use crate::physics::Shaft;
 use crate::rattle::Impacts;
 use fmi2_shell::values::Values;
-use fmi2_shell::{Identity, Log, Slave};
+use fmi2_shell::{EventInfo, Identity, Interface, Log, Slave};
+use model_exchange::{NX, NZ};
 use serde::{Deserialize, Serialize};
 
 /// The contract's log categories by role (errors and warnings first, as the shell wants).
@@ -27,6 +29,8 @@ const _: () = assert!(contract::log::logStatusWarning == fmi2_shell::log::WARNIN
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Instance {
     pub state: FmiState,
+    /// Co-Simulation, or Model Exchange (the importer integrates; see `model_exchange`).
+    interface: Interface,
     values: Values,
     /// dτ_in/dt from fmi2SetRealInputDerivatives [N m/s] (0 until set: a held torque); the
     /// derivatives of θ_M and ω_M are kept as the inputs omega_M and alpha_M.
@@ -82,10 +86,10 @@ impl Instance {
     /// the simulation built from the values so far).
     fn real_value(&mut self, vr: u32) -> FmiResult<f64> {
         Ok(match Self::variable(Kind::Real, vr)?.causality {
-            Causality::Output => self
+            Causality::Output | Causality::Local => self
                 .current()?
                 .real_output(vr)
-                .expect("every Real output of the contract is computed"),
+                .expect("every computed Real variable of the contract is computed"),
             _ => self.values.real(vr),
         })
     }
@@ -97,12 +101,14 @@ impl Instance {
                 "{} is an output: it cannot be set",
                 var.name
             ))),
-            Causality::Parameter if self.state == FmiState::StepComplete => {
-                Err(FmiError::error(format!(
-                    "{} is a fixed parameter: set it before fmi2ExitInitializationMode",
-                    var.name
-                )))
-            }
+            Causality::Local => Err(FmiError::error(format!(
+                "{} is computed by the FMU: it cannot be set",
+                var.name
+            ))),
+            Causality::Parameter if self.state.is_initialised() => Err(FmiError::error(format!(
+                "{} is a fixed parameter: set it before fmi2ExitInitializationMode",
+                var.name
+            ))),
             _ => Ok(()),
         }
     }
@@ -112,13 +118,14 @@ impl Instance {
     /// (inputs take effect at once).
     fn inputs_changed(&mut self) {
         match self.state {
+            FmiState::EventMode | FmiState::ContinuousTimeMode => {
+                let (shaft, tau, rate) = self.shaft_inputs();
+                let sim = self.sim.as_mut().expect("initialised");
+                sim.set_shaft_inputs(shaft);
+                sim.set_torque(tau, rate);
+            }
             FmiState::StepComplete => {
-                let shaft = Shaft {
-                    theta: self.values.real(vr::theta_M),
-                    omega: self.values.real(vr::omega_M),
-                    alpha: self.values.real(vr::alpha_M),
-                };
-                let (tau, rate) = (self.values.real(vr::tau_in), self.tau_in_rate);
+                let (shaft, tau, rate) = self.shaft_inputs();
                 let sim = self.sim.as_mut().expect("initialised");
                 let before = sim.impacts();
                 sim.set_shaft(shaft);
@@ -134,7 +141,33 @@ impl Instance {
         }
     }
 
-    /// Refuses any value reference: the model has no Boolean or String variables.
+    /// The main shaft's inputs as set: its motion (inputs mode), its torque and rate (torque
+    /// mode).
+    fn shaft_inputs(&self) -> (Shaft, f64, f64) {
+        let shaft = Shaft {
+            theta: self.values.real(vr::theta_M),
+            omega: self.values.real(vr::omega_M),
+            alpha: self.values.real(vr::alpha_M),
+        };
+        (shaft, self.values.real(vr::tau_in), self.tau_in_rate)
+    }
+
+    /// The running simulation, for the calls of Model Exchange.
+    fn model_exchange(&mut self) -> &mut Simulation {
+        self.sim.as_mut().expect("initialised")
+    }
+
+    /// Checks the length of an importer's vector.
+    fn length(what: &str, n: usize, expected: usize) -> FmiResult {
+        if n == expected {
+            Ok(())
+        } else {
+            Err(FmiError::error(format!(
+                "{what} has {n} elements: the model has {expected}"
+            )))
+        }
+    }
+
     /// Main inputs coherent with the previous values: `theta_M` and `omega_M` (inputs mode)
     /// or `tau_in` (torque mode) follow the extrapolation when the master does not set them
     /// again (see `Simulation::step_to`).
@@ -248,7 +281,12 @@ impl Slave for Instance {
         log_categories: LOG_CATEGORIES,
         state_magic: *b"GRFS",
         state_version: 6,
+        model_exchange: true,
     };
+
+    fn interface(&self) -> Interface {
+        self.interface
+    }
 
     fn log(&mut self) -> &mut Log {
         &mut self.log
@@ -262,9 +300,10 @@ impl Slave for Instance {
         self.state = state;
     }
 
-    fn new(logging_on: bool) -> Self {
+    fn new(logging_on: bool, interface: Interface) -> Self {
         Instance {
             state: FmiState::Instantiated,
+            interface,
             values: Values::start(contract::VARIABLES),
             tau_in_rate: 0.0,
             start_time: 0.0,
@@ -305,7 +344,10 @@ impl Slave for Instance {
         let sim = self.build()?;
         self.sim = Some(sim);
         self.last_successful_time = self.start_time;
-        self.state = FmiState::StepComplete;
+        self.state = match self.interface {
+            Interface::CoSimulation => FmiState::StepComplete,
+            Interface::ModelExchange => FmiState::EventMode,
+        };
         Ok(())
     }
 
@@ -358,7 +400,7 @@ impl Slave for Instance {
             self.values.set_real(*vr, *value);
             shaft_changed |= matches!(*vr, vr::theta_M | vr::omega_M | vr::alpha_M | vr::tau_in);
         }
-        if shaft_changed || self.state != FmiState::StepComplete {
+        if shaft_changed || !self.state.is_initialised() {
             self.inputs_changed();
         }
         Ok(())
@@ -511,6 +553,92 @@ impl Slave for Instance {
         }
         Ok(())
     }
+
+    // Model Exchange (see `model_exchange`).
+
+    fn set_time(&mut self, t: f64) -> FmiResult {
+        if !t.is_finite() {
+            return Err(FmiError::error(format!(
+                "time = {t} refused: it must be finite"
+            )));
+        }
+        self.model_exchange().set_time(t);
+        Ok(())
+    }
+
+    fn set_continuous_states(&mut self, x: &[f64]) -> FmiResult {
+        Self::length("x", x.len(), NX)?;
+        if let Some(bad) = x.iter().position(|v| !v.is_finite()) {
+            return Err(FmiError::error(format!(
+                "x[{bad}] = {} refused: the continuous states must be finite",
+                x[bad]
+            )));
+        }
+        self.model_exchange()
+            .set_continuous_states(x.try_into().expect("length checked"));
+        Ok(())
+    }
+
+    fn get_continuous_states(&mut self, x: &mut [f64]) -> FmiResult {
+        Self::length("x", x.len(), NX)?;
+        x.copy_from_slice(&self.current()?.continuous_states());
+        Ok(())
+    }
+
+    fn get_nominals_of_continuous_states(&mut self, x: &mut [f64]) -> FmiResult {
+        Self::length("x_nominal", x.len(), NX)?;
+        x.copy_from_slice(&self.current()?.nominals());
+        Ok(())
+    }
+
+    fn get_derivatives(&mut self, dx: &mut [f64]) -> FmiResult {
+        Self::length("derivatives", dx.len(), NX)?;
+        dx.copy_from_slice(&self.current()?.derivatives());
+        Ok(())
+    }
+
+    fn get_event_indicators(&mut self, z: &mut [f64]) -> FmiResult {
+        Self::length("eventIndicators", z.len(), NZ)?;
+        z.copy_from_slice(&self.current()?.event_indicators());
+        Ok(())
+    }
+
+    fn enter_event_mode(&mut self) -> FmiResult {
+        self.state = FmiState::EventMode;
+        Ok(())
+    }
+
+    fn new_discrete_states(&mut self) -> FmiResult<EventInfo> {
+        let sim = self.model_exchange();
+        let before = sim.impacts();
+        let next_event_time = sim.update_discrete_states();
+        let after = sim.impacts();
+        if before != after {
+            let t = sim.t;
+            self.log_line(Status::Ok, EVENTS, || {
+                format!(
+                    "t = {t}: impact at |xi'| = {:e} m/s ({} on F+, {} on F- so far)",
+                    after.last_speed, after.count[0], after.count[1]
+                )
+            });
+        }
+        Ok(EventInfo {
+            next_event_time,
+            ..EventInfo::default()
+        })
+    }
+
+    fn enter_continuous_time_mode(&mut self) -> FmiResult {
+        self.state = FmiState::ContinuousTimeMode;
+        Ok(())
+    }
+
+    fn completed_integrator_step(&mut self) -> FmiResult<bool> {
+        let sim = self.model_exchange();
+        sim.completed_integrator_step();
+        self.last_successful_time = sim.t;
+        Ok(false)
+    }
 }
 
 #[cfg(test)]
@@ -519,7 +647,7 @@ mod tests {
     use fmi2_shell::fmu_state::{deserialize, serialize};
 
     fn stepped() -> Instance {
-        let mut i = Instance::new(false);
+        let mut i = Instance::new(false, Interface::CoSimulation);
         i.set_integer(&[vr::excitation], &[1]).unwrap();
         i.enter_initialization_mode().unwrap();
         i.exit_initialization_mode().unwrap();

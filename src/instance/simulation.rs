@@ -66,7 +66,7 @@ impl<S: GearPair<N> + Jacobian<N> + Copy, const N: usize> Stepped<S, N> {
     }
 
     /// The statistics window opens now: its quadratures are kept.
-    fn open_window(&mut self) {
+    pub(super) fn open_window(&mut self) {
         let q = S::quadratures(&self.y);
         self.system.window_mut().open(q);
     }
@@ -412,7 +412,10 @@ impl Simulation {
             vr::solver_rejected => now.stats.rejected as f64,
             vr::solver_rhs => now.stats.rhs_evals as f64,
             vr::solver_implicit_steps => now.stats.implicit_steps as f64,
-            _ => return stat_real(&now.metrics(self.t), vr),
+            _ => {
+                return stat_real(&now.metrics(self.t), vr)
+                    .or_else(|| self.model_exchange_local(vr));
+            }
         })
     }
 

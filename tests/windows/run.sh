@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The win64 binary of the FMU, checked on Linux (run by `make test-windows`, part of `make test`):
 #   1. the FMU carries binaries/win64/GearRattle.dll beside binaries/linux64/GearRattle.so;
-#   2. the DLL's export table is exactly the FMI 2.0 Co-Simulation functions, and its import
+#   2. the DLL's export table is exactly the FMI 2.0 Co-Simulation and Model Exchange
+#      functions, and its import
 #      table names only DLLs that a plain Windows 10 has;
 #   3. fmu_run.c, built with MinGW-w64 and run under Wine, steps the DLL through scene S1
 #      (sine mode, the paper's defaults) to 0.2 s in 1 ms communication steps; the same C file
@@ -52,23 +53,27 @@ step "FMU carries linux64 and win64 binaries (GUID $GUID)"
 
 # ---- 2. export and import tables of the DLL ----
 x86_64-w64-mingw32-objdump -p "$DLL" >"$WORK/run/objdump.txt" || fail "objdump -p $DLL failed"
-# Every function of FMI 2.0 Co-Simulation (the common ones, then the co-simulation ones).
-FMI2_CS="fmi2GetTypesPlatform fmi2GetVersion fmi2SetDebugLogging fmi2Instantiate
+# Every function of FMI 2.0 Co-Simulation and Model Exchange (the common ones, then the
+# co-simulation ones, then those of Model Exchange).
+FMI2="fmi2GetTypesPlatform fmi2GetVersion fmi2SetDebugLogging fmi2Instantiate
 fmi2FreeInstance fmi2SetupExperiment fmi2EnterInitializationMode fmi2ExitInitializationMode
 fmi2Terminate fmi2Reset fmi2GetReal fmi2GetInteger fmi2GetBoolean fmi2GetString fmi2SetReal
 fmi2SetInteger fmi2SetBoolean fmi2SetString fmi2GetFMUstate fmi2SetFMUstate fmi2FreeFMUstate
 fmi2SerializedFMUstateSize fmi2SerializeFMUstate fmi2DeSerializeFMUstate
 fmi2GetDirectionalDerivative fmi2SetRealInputDerivatives fmi2GetRealOutputDerivatives
 fmi2DoStep fmi2CancelStep fmi2GetStatus fmi2GetRealStatus fmi2GetIntegerStatus
-fmi2GetBooleanStatus fmi2GetStringStatus"
-expected=$(tr -s ' \n' '\n\n' <<<"$FMI2_CS" | sort)
+fmi2GetBooleanStatus fmi2GetStringStatus
+fmi2SetTime fmi2SetContinuousStates fmi2EnterEventMode fmi2NewDiscreteStates
+fmi2EnterContinuousTimeMode fmi2CompletedIntegratorStep fmi2GetDerivatives
+fmi2GetEventIndicators fmi2GetContinuousStates fmi2GetNominalsOfContinuousStates"
+expected=$(tr -s ' \n' '\n\n' <<<"$FMI2" | sort)
 exported=$(sed -n '/^\[Ordinal\/Name Pointer\] Table/,/^$/p' "$WORK/run/objdump.txt" |
     sed -n 's/^[[:space:]]*\[ *[0-9]*\] //p' | sort)
 entries=$(sed -n '/^Export Address Table -- Ordinal Base/,/^$/p' "$WORK/run/objdump.txt" |
     grep -c 'Export RVA' || true)
 echo "$exported" >"$WORK/run/exports.txt"
 if [ "$exported" != "$expected" ]; then
-    echo "exported by name, versus the FMI 2.0 Co-Simulation functions (diff expected actual):" >&2
+    echo "exported by name, versus the FMI 2.0 functions (diff expected actual):" >&2
     diff <(echo "$expected") <(echo "$exported") >&2 || true
     fail "the DLL's export table is not exactly the fmi2* functions (see mk/windows-link.sh)"
 fi

@@ -5,7 +5,7 @@
 use crate::contract::{self, Causality, Kind, LOG_CATEGORIES, VARIABLES, vr};
 use crate::model::{Params, State};
 use fmi2_shell::values::Values;
-use fmi2_shell::{FmiError, FmiResult, FmiState, Identity, Log, Slave};
+use fmi2_shell::{FmiError, FmiResult, FmiState, Identity, Interface, Log, Slave};
 use serde::{Deserialize, Serialize};
 
 /// Everything that determines the future of an instance (what fmi2GetFMUstate saves), and
@@ -63,9 +63,10 @@ impl Slave for Instance {
         log_categories: LOG_CATEGORIES,
         state_magic: *b"FLYS",
         state_version: 2,
+        model_exchange: false,
     };
 
-    fn new(logging_on: bool) -> Self {
+    fn new(logging_on: bool, _interface: Interface) -> Self {
         Instance {
             state: FmiState::Instantiated,
             t: 0.0,
@@ -255,7 +256,7 @@ mod tests {
     use fmi2_shell::slave::{restore, snapshot};
 
     fn running() -> Instance {
-        let mut i = Instance::new(false);
+        let mut i = Instance::new(false, Interface::CoSimulation);
         i.setup_experiment(None, 0.0).unwrap();
         i.enter_initialization_mode().unwrap();
         i.exit_initialization_mode().unwrap();
@@ -272,7 +273,7 @@ mod tests {
         let saved: Instance = deserialize(&serialize(&i)).unwrap();
         i.do_step(1e-3, 2.5e-3).unwrap();
         let first = serialize(&i);
-        let mut j = Instance::new(false);
+        let mut j = Instance::new(false, Interface::CoSimulation);
         restore(&mut j, &saved);
         j.do_step(1e-3, 2.5e-3).unwrap();
         assert_eq!(serialize(&j), first);
@@ -298,7 +299,7 @@ mod tests {
 
     #[test]
     fn invalid_parameter_keeps_initialisation_mode() {
-        let mut i = Instance::new(false);
+        let mut i = Instance::new(false, Interface::CoSimulation);
         i.enter_initialization_mode().unwrap();
         i.set_real(&[vr::I_M], &[0.0]).unwrap();
         assert!(

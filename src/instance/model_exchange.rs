@@ -1,0 +1,225 @@
+//! Model Exchange: the gear pair as continuous states, derivatives and event indicators for
+//! the importer's solver, on the same [`Simulation`] (its systems, regions, counters and
+//! statistics window) as co-simulation, whose own solver then stays idle.
+//!
+//! States (the contract's `STATES`, in this order): ξ (the transmission error itself, so that
+//! nothing is lost at idle speed over an hour), ω_L, the main shaft's θ_M and ω_M (torque
+//! mode; otherwise unused and constant), then the quadratures of
+//! [`crate::rattle::window::quadrature`] (dissipated energies, the shaft's work, ∫a², ∫F,
+//! ∫F²). With ω_L as a state, ξ' = r_L ω_L − r_M ω_M needs only the shaft's speed: in the
+//! inputs mode the derivatives read θ_M and ω_M as set (α_M is not needed), in the sine mode
+//! the time, in the torque mode the shaft's own states.
+//!
+//! Event indicators: ξ + ε, ξ, ξ − G, ξ − G − ε, the edges of the contact law (MODEL.md §2),
+//! and ξ' in the gap (its turning points, where a touch that stays in a band shows).
+//! The derivatives take the formula of the region ξ is in; at an event the gear pair's
+//! region follows ξ across the edges, and an onset counts an impact, exactly as in
+//! co-simulation.
+#![allow(non_snake_case)]
+
+use super::simulation::{Drive, Gear, Simulation};
+use crate::physics::{Excitation, Polynomial, Region, Shaft};
+use crate::rattle::window::quadrature;
+use crate::rattle::{GearPair, Rattle, XI, XI_DOT, quadrature_rates, torque};
+
+/// Number of continuous states.
+pub const NX: usize = 4 + quadrature::COUNT;
+/// Number of event indicators.
+pub const NZ: usize = 5;
+
+/// Nominal magnitudes of the states, for the importer's error weights: ξ on the scale of
+/// the backlash, speeds of 10 rad/s, a shaft angle of 1 rad, the energies and integrals on
+/// the scale of a second of the paper's bench.
+fn nominals(G: f64) -> [f64; NX] {
+    [G, 10.0, 1.0, 10.0, 1e-3, 1e-2, 1e-2, 1e2, 1.0, 1e2]
+}
+
+impl Simulation {
+    /// The continuous states x.
+    pub fn continuous_states(&self) -> [f64; NX] {
+        let mut x = [0.0; NX];
+        match &self.gear {
+            Gear::Kinematic(k) => {
+                x[0] = k.y[XI];
+                x[1] = k.system.loads_at(self.t, &k.y).omega_L;
+                x[4..].copy_from_slice(&Rattle::quadratures(&k.y));
+            }
+            Gear::Torque(k) => {
+                x[0] = k.y[XI];
+                x[1] = k.system.loads_at(self.t, &k.y).omega_L;
+                (x[2], x[3]) = (k.y[torque::THETA_M], k.y[torque::OMEGA_M]);
+                x[4..].copy_from_slice(&torque::TorqueRattle::quadratures(&k.y));
+            }
+        }
+        x
+    }
+
+    /// Takes the importer's states x: ξ' follows from ω_L and the shaft's speed now.
+    pub fn set_continuous_states(&mut self, x: &[f64; NX]) {
+        match &mut self.gear {
+            Gear::Kinematic(k) => {
+                let p = &k.system.dynamics.params;
+                let omega_M = k.system.excitation.at(self.t).omega;
+                k.y[XI] = x[0];
+                k.y[XI_DOT] = p.r_L * x[1] - p.r_M * omega_M;
+                k.y[crate::rattle::E_CONTACT..].copy_from_slice(&x[4..]);
+            }
+            Gear::Torque(k) => {
+                let p = &k.system.dynamics.params;
+                k.y[XI] = x[0];
+                k.y[XI_DOT] = p.r_L * x[1] - p.r_M * x[3];
+                (k.y[torque::THETA_M], k.y[torque::OMEGA_M]) = (x[2], x[3]);
+                k.y[torque::E_CONTACT..].copy_from_slice(&x[4..]);
+            }
+        }
+    }
+
+    /// dx/dt at the current time and states, with the formula of the region ξ is in: the
+    /// contact force is continuous with a continuous slope across the edges (MODEL.md §2),
+    /// so the importer's solver sees a smooth enough right-hand side wherever its trial
+    /// points fall, also past an edge it has not located yet.
+    pub fn derivatives(&self) -> [f64; NX] {
+        let mut dx = [0.0; NX];
+        let (loads, shaft, p) = match &self.gear {
+            Gear::Kinematic(k) => {
+                let mut system = k.system;
+                system.region = system.dynamics.law.classify(k.y[XI]);
+                let shaft = system.excitation.at(self.t);
+                (
+                    system.loads_at(self.t, &k.y),
+                    shaft,
+                    &k.system.dynamics.params,
+                )
+            }
+            Gear::Torque(k) => {
+                let mut system = k.system;
+                system.region = system.dynamics.law.classify(k.y[XI]);
+                let (loads, shaft) = system.loads(self.t, &k.y);
+                (dx[2], dx[3]) = (shaft.omega, shaft.alpha);
+                (loads, shaft, &k.system.dynamics.params)
+            }
+        };
+        let xi_dot = p.r_L * loads.omega_L - p.r_M * shaft.omega;
+        (dx[0], dx[1]) = (xi_dot, loads.alpha_L);
+        dx[4..].copy_from_slice(&quadrature_rates(p, &loads, xi_dot, shaft.omega));
+        dx
+    }
+
+    /// The event indicators: ξ against the contact law's four edges, and in the gap ξ' (1
+    /// elsewhere). A touch that enters a band and leaves it within one of the importer's
+    /// steps changes no edge's sign at the step's ends, but has a turning point in the band:
+    /// the event there finds ξ past the edge and counts the impact.
+    pub fn event_indicators(&self) -> [f64; NZ] {
+        let (xi, xi_dot, p, region) = match &self.gear {
+            Gear::Kinematic(k) => (
+                k.y[XI],
+                k.y[XI_DOT],
+                &k.system.dynamics.params,
+                k.system.region,
+            ),
+            Gear::Torque(k) => (
+                k.y[XI],
+                k.y[XI_DOT],
+                &k.system.dynamics.params,
+                k.system.region,
+            ),
+        };
+        let turning = if region == Region::Gap { xi_dot } else { 1.0 };
+        [xi + p.epsilon, xi, xi - p.G, xi - p.G - p.epsilon, turning]
+    }
+
+    pub fn nominals(&self) -> [f64; NX] {
+        nominals(match &self.gear {
+            Gear::Kinematic(k) => k.system.dynamics.params.G,
+            Gear::Torque(k) => k.system.dynamics.params.G,
+        })
+    }
+
+    /// The importer's time. In the inputs mode the shaft's inputs hold until set again.
+    pub fn set_time(&mut self, t: f64) {
+        self.t = t;
+        self.hold_inputs();
+    }
+
+    /// New shaft inputs (inputs mode) as the importer sets them: unlike co-simulation's
+    /// [`Simulation::set_shaft`], the states do not move (ξ is the importer's state).
+    pub fn set_shaft_inputs(&mut self, shaft: Shaft) {
+        if let Drive::Inputs(_) = self.drive {
+            self.drive = Drive::Inputs(shaft);
+            self.hold_inputs();
+        }
+    }
+
+    fn hold_inputs(&mut self) {
+        if let (Drive::Inputs(shaft), Gear::Kinematic(k)) = (self.drive, &mut self.gear) {
+            k.system.excitation = Excitation::Polynomial(Polynomial {
+                t0: self.t,
+                at_t0: Shaft {
+                    alpha: 0.0,
+                    ..shaft
+                },
+            });
+        }
+    }
+
+    /// Event mode: the region follows ξ across the edges it passed (an onset counts an
+    /// impact and enters the statistics) and the statistics window opens when its time has
+    /// come. Returns the next time event: the window's opening, if still ahead.
+    pub fn update_discrete_states(&mut self) -> Option<f64> {
+        let t = self.t;
+        match &mut self.gear {
+            Gear::Kinematic(k) => k.update_discrete_states(t),
+            Gear::Torque(k) => k.update_discrete_states(t),
+        }
+    }
+
+    /// After an accepted step of the importer: |a| there for the statistics' peak.
+    pub fn completed_integrator_step(&mut self) {
+        let t = self.t;
+        match &mut self.gear {
+            Gear::Kinematic(k) => k.sample_acceleration(t),
+            Gear::Torque(k) => k.sample_acceleration(t),
+        }
+    }
+
+    /// The Model Exchange variables that are not outputs: the states θ_M and ω_M of the
+    /// torque mode, the quadratures W_shaft, ∫a², ∫F, ∫F², and the derivatives.
+    pub fn model_exchange_local(&self, vr: u32) -> Option<f64> {
+        use crate::contract::{DERIVATIVES, STATES};
+        if let Some(i) = STATES.iter().position(|&s| s == vr) {
+            return Some(self.continuous_states()[i]);
+        }
+        let i = DERIVATIVES.iter().position(|&d| d == vr)?;
+        Some(self.derivatives()[i])
+    }
+}
+
+impl<S: GearPair<N> + crate::integrator::Jacobian<N> + Copy, const N: usize>
+    super::simulation::Stepped<S, N>
+{
+    fn update_discrete_states(&mut self, t: f64) -> Option<f64> {
+        // The importer's root search may stop exactly on an edge: ξ is then taken a few
+        // rounding errors further along ξ', so that an edge reached on the way out is crossed
+        // now, and one just crossed is not crossed back.
+        let mut probe = self.y;
+        let (xi, xi_dot) = (probe[S::GUARD], probe[S::RATE]);
+        let (lo, hi) = self.system.piece();
+        let scale = [xi, lo, hi]
+            .iter()
+            .filter(|v| v.is_finite())
+            .fold(0.0f64, |m, v| m.max(v.abs()));
+        probe[S::GUARD] = xi + xi_dot.signum() * 8.0 * f64::EPSILON * scale;
+        self.system.settle(t, &probe);
+        let window = self.system.window();
+        if !window.is_opened() && window.from <= t {
+            self.open_window();
+        }
+        let window = self.system.window();
+        (!window.is_opened() && window.from.is_finite()).then_some(window.from)
+    }
+
+    fn sample_acceleration(&mut self, t: f64) {
+        let a = self.system.dynamics().params.r_L * self.system.loads_at(t, &self.y).alpha_L;
+        self.system.window_mut().acceleration(t, a);
+    }
+}
