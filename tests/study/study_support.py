@@ -34,6 +34,18 @@ def rows(out):
     return pq.read_table(os.path.join(out, "points.parquet")).drop(["cpu_s"])
 
 
+def assert_same_rows(got, want):
+    """Equal tables, or a message naming the first point and columns that differ."""
+    if got.equals(want):
+        return
+    a, b = got.to_pylist(), want.to_pylist()
+    assert len(a) == len(b), f"{len(a)} rows, expected {len(b)}"
+    for x, y in zip(a, b):
+        diff = {k: (x.get(k), y[k]) for k in y
+                if x.get(k) != y[k] and not (x.get(k) != x.get(k) and y[k] != y[k])}  # NaN
+        assert not diff, f"point {y['point']} differs (got, expected): {diff}"
+
+
 def free_port():
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))

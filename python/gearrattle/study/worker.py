@@ -182,9 +182,20 @@ def instance(guid):
         insts = _THREAD.instances = {}
     if guid not in insts:
         if guid not in _FMUS:
-            raise RuntimeError(f"FMU {guid} is not installed in this process (install_fmu)")
+            _install_from_plugin(guid)
         insts[guid] = Instance(*_FMUS[guid])
     return insts[guid]
+
+
+def _install_from_plugin(guid):
+    """The FMU from this Dask worker's plugin, should a task start before the plugin's setup."""
+    try:
+        from distributed import get_worker
+
+        plugin = get_worker().plugins[FMUPlugin.name_of(guid)]
+    except (ImportError, ValueError, KeyError):
+        raise RuntimeError(f"FMU {guid} is not installed in this process (install_fmu)") from None
+    install_fmu(plugin.guid, plugin.data)
 
 
 def drop_instance(guid):
@@ -227,7 +238,11 @@ class FMUPlugin(WorkerPlugin):
 
     def __init__(self, guid, data):
         self.guid, self.data = guid, data
-        self.name = f"gearrattle-fmu-{guid}"
+        self.name = self.name_of(guid)
+
+    @staticmethod
+    def name_of(guid):
+        return f"gearrattle-fmu-{guid}"
 
     def setup(self, worker):
         install_fmu(self.guid, self.data)
