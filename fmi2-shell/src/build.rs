@@ -342,9 +342,17 @@ fn xml(c: &Contract, guid: &str) -> String {
         x += "    </Derivatives>\n";
     }
     x += "    <InitialUnknowns>\n";
+    // Outputs, and the states and their derivatives (all calculated: none has a start).
     let mut initial: Vec<usize> = outputs.iter().map(|(i, _)| *i).collect();
     initial.extend(&derivatives);
+    initial.extend(
+        c.variable
+            .iter()
+            .filter_map(|v| v.derivative_of.as_deref())
+            .map(index_of),
+    );
     initial.sort();
+    initial.dedup();
     for i in initial {
         writeln!(x, "      <Unknown index=\"{i}\"/>").unwrap();
     }
