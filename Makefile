@@ -9,6 +9,9 @@ VENV := .venv
 PY := $(VENV)/bin/python
 FMU := target/fmu/GearRattle.fmu
 LIB := target/release/libgear_rattle.so
+# The FMU's binaries as built (with line tables, for debugging) and as packaged (stripped).
+FMU_DEBUG := target/fmu/debug
+FMU_STRIPPED := target/fmu/stripped
 # Fragments in mk/ (one per capability: windows, benchmarks, rattle map) add to these.
 FMU_DEPS :=
 PACKAGE_FLAGS :=
@@ -21,13 +24,16 @@ all: fmu
 # Included before the rules so that the fragments' prerequisites are seen.
 include $(wildcard mk/*.mk)
 
-## fmu: build target/fmu/GearRattle.fmu (linux64)
+## fmu: build target/fmu/GearRattle.fmu (linux64, darwin64, win64)
 fmu: $(FMU)
 
-$(FMU): $(LIB) $(FMU_DEPS) src/bin/package.rs
-	cargo run --release --quiet --bin package -- --lib $(LIB) $(PACKAGE_FLAGS) --out $(FMU)
+# The fragments build the binaries and name them in PACKAGE_FLAGS: mk/portable.mk linux64
+# (for glibc 2.17) and darwin64 with zig, mk/windows.mk win64.
+$(FMU): $(FMU_DEPS) src/bin/package.rs | libclang
+	cargo run --release --quiet --bin package -- $(PACKAGE_FLAGS) --out $(FMU)
 
-# cargo decides what to rebuild; this rule always asks it.
+# The native library, loaded by the C-API tests (the FMU's linux64 binary is built by
+# mk/portable.mk). cargo decides what to rebuild; this rule always asks it.
 $(LIB): FORCE | libclang
 	cargo build --release --lib
 
@@ -53,6 +59,19 @@ $(VENV)/.installed: requirements.txt
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --disable-pip-version-check -r requirements.txt
 	touch $@
+
+# $(1): a Debian package, $(2): a shell test that succeeds when it is installed.
+# Installs it with apt-get when root, else says how and stops.
+define apt_install
+	@if $(2); then :; \
+	elif [ "$$(id -u)" = 0 ]; then \
+		echo "$(1) missing: installing it with apt-get"; \
+		apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends $(1) >/dev/null; \
+	else \
+		echo "$(1) is missing: run 'sudo apt-get install $(1)', then retry"; \
+		exit 1; \
+	fi
+endef
 
 # fmi-sys generates its bindings with bindgen, which loads libclang at build time.
 .PHONY: libclang

@@ -7,38 +7,29 @@
 WIN_TARGET := x86_64-pc-windows-gnu
 WIN_DLL := target/$(WIN_TARGET)/release/gear_rattle.dll
 
-FMU_DEPS += $(WIN_DLL)
-PACKAGE_FLAGS += --win64 $(WIN_DLL)
+# Packaged stripped, the unstripped copy in target/fmu/debug/win64 (rules in mk/portable.mk).
+FMU_DEPS += $(FMU_STRIPPED)/win64/GearRattle.dll
+PACKAGE_FLAGS += --win64 $(FMU_STRIPPED)/win64/GearRattle.dll
 TEST_TARGETS += test-windows
 
 .PHONY: windows-toolchain windows-wine test-windows
 
 # fmi-sys's bindgen parses the FMI headers for the Windows target against MinGW's headers,
-# whose malloc.h needs clang's own include directory (mm_malloc.h) first.
+# whose malloc.h needs clang's own include directory (mm_malloc.h) first. Built as a cdylib
+# alone, like the portable binaries (see mk/portable.mk).
 $(WIN_DLL): FORCE | libclang windows-toolchain
 	@mm_malloc=$$(ls /usr/lib/llvm-*/lib/clang/*/include/mm_malloc.h 2>/dev/null | sort -V | tail -n 1); \
 	[ -n "$$mm_malloc" ] || { echo "clang's mm_malloc.h not found (libclang-dev installs it)"; exit 1; }; \
 	export BINDGEN_EXTRA_CLANG_ARGS_x86_64_pc_windows_gnu="-I$$(dirname "$$mm_malloc")"; \
 	echo "BINDGEN_EXTRA_CLANG_ARGS_x86_64_pc_windows_gnu=$$BINDGEN_EXTRA_CLANG_ARGS_x86_64_pc_windows_gnu"; \
-	echo "cargo build --release --lib --target $(WIN_TARGET)"; \
-	cargo build --release --lib --target $(WIN_TARGET)
+	echo "cargo rustc --release --lib --crate-type cdylib --target $(WIN_TARGET)"; \
+	cargo rustc --release --lib --crate-type cdylib --target $(WIN_TARGET)
+
+$(FMU_DEBUG)/win64/GearRattle.dll: $(WIN_DLL)
 
 ## test-windows: the win64 DLL under Wine agrees with the linux64 .so; its export/import tables
 test-windows: fmu | windows-toolchain windows-wine
 	tests/windows/run.sh $(FMU)
-
-# $(1): a Debian package, $(2): a shell test that succeeds when it is installed.
-# Installs it with apt-get when root, else says how and stops.
-define apt_install
-	@if $(2); then :; \
-	elif [ "$$(id -u)" = 0 ]; then \
-		echo "$(1) missing: installing it with apt-get"; \
-		apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends $(1) >/dev/null; \
-	else \
-		echo "$(1) is missing: run 'sudo apt-get install $(1)', then retry"; \
-		exit 1; \
-	fi
-endef
 
 windows-toolchain:
 	@rustup target list --installed | grep -qx $(WIN_TARGET) || { \

@@ -460,9 +460,14 @@ fn rust(c: &Contract, guid: &str) -> String {
 /// --exclude-symbols only affects automatic exports), so nothing here can take a name out.
 /// The linker set in .cargo/config.toml, mk/windows-link.sh, links with a copy of rustc's
 /// list narrowed to fmi2*; tests/windows/run.sh checks the DLL's export table.
+///
+/// macOS: see `apple_link_args`.
 pub fn restrict_exports() {
     let out = PathBuf::from(env::var("OUT_DIR").unwrap());
     let target_os = env::var("CARGO_CFG_TARGET_OS").unwrap_or_default();
+    if target_os == "macos" {
+        apple_link_args();
+    }
     if target_os != "linux" {
         return;
     }
@@ -476,4 +481,14 @@ pub fn restrict_exports() {
         "cargo:rustc-cdylib-link-arg=-Wl,--version-script={}",
         script.display()
     );
+}
+
+/// macOS: the dylib links only the libraries it calls into. The `libc` crate asks for
+/// libiconv (and cargo-zigbuild adds libcharset with it), which nothing here calls; without
+/// -dead_strip_dylibs both would be load commands, and a dylib that needs libSystem alone
+/// loads on any macOS. The exports are kept to fmi2* by mk/darwin-link.py and
+/// mk/darwin-exports.py: zig's Mach-O linker ignores the exported-symbols list that rustc
+/// passes.
+fn apple_link_args() {
+    println!("cargo:rustc-cdylib-link-arg=-Wl,-dead_strip_dylibs");
 }

@@ -10,9 +10,9 @@ use zip::write::SimpleFileOptions;
 
 /// A binary to put into the FMU, with the platform folder it goes to.
 pub struct Binary<'a> {
-    /// FMI platform folder: "linux64", "win64".
+    /// FMI platform folder: "linux64", "darwin64", "win64".
     pub platform: &'static str,
-    /// File extension on that platform: "so", "dll".
+    /// File extension on that platform: "so", "dylib", "dll".
     pub extension: &'static str,
     pub path: &'a Path,
 }

@@ -1,0 +1,79 @@
+# Portable binaries (issue 19), built with zig through cargo-zigbuild:
+#   linux64   binaries/linux64/GearRattle.so for glibc 2.17 (RHEL 7 and every later Linux),
+#   darwin64  binaries/darwin64/GearRattle.dylib, universal (x86_64 + arm64), macOS 11 or later,
+# and every binary of the FMU stripped when packaged: the unstripped copies, with their line
+# tables, stay in target/fmu/debug/<platform>/ for debugging. tests/portable/check.sh checks
+# the packaged binaries (`make test-portable`, part of `make test`).
+# Installs what it needs when missing: zig (PyPI's ziglang, pinned in requirements.txt, into
+# the .venv), cargo-zigbuild (cargo install, pinned here), the rustup targets, and Debian's
+# llvm (llvm-strip, llvm-objdump, llvm-nm, llvm-lipo) with apt-get when root.
+
+ZIGBUILD_VERSION := 0.24.1
+LINUX_TARGET := x86_64-unknown-linux-gnu.2.17
+LINUX_SO := target/x86_64-unknown-linux-gnu/release/libgear_rattle.so
+DARWIN_ARCHS := x86_64 aarch64
+DARWIN_SLICES := $(foreach a,$(DARWIN_ARCHS),target/$(a)-apple-darwin/release/libgear_rattle.dylib)
+
+FMU_DEPS += $(FMU_STRIPPED)/linux64/GearRattle.so $(FMU_STRIPPED)/darwin64/GearRattle.dylib
+PACKAGE_FLAGS += --lib $(FMU_STRIPPED)/linux64/GearRattle.so \
+	--darwin64 $(FMU_STRIPPED)/darwin64/GearRattle.dylib
+TEST_TARGETS += test-portable
+
+.PHONY: zig-toolchain llvm-tools test-portable
+
+# Each binary is built as a cdylib alone (`cargo rustc --crate-type cdylib`): with the rlib
+# crate type of Cargo.toml beside it, LTO keeps every Rust function public and the linkers
+# keep them all (the packaged binaries would be 2-3 times larger).
+# cargo-zigbuild runs from target/: zig prints its include directories relative to the working
+# directory when they lie below it (the .venv does), and cargo-zigbuild hands them as they are to
+# bindgen (fmi-sys), which runs elsewhere and then finds no stddef.h. cargo still reads
+# .cargo/config.toml from the parent directory. MACOSX_DEPLOYMENT_TARGET sets the dylib's
+# minimum macOS (zig's default is its newest).
+ZIGBUILD = mkdir -p target && cd target && \
+	CARGO_ZIGBUILD_PYTHON_PATH=$(CURDIR)/$(PY) MACOSX_DEPLOYMENT_TARGET=11.0 \
+	cargo-zigbuild rustc --manifest-path $(CURDIR)/Cargo.toml --release --lib --crate-type cdylib
+
+# cargo decides what to rebuild; these rules always ask it.
+$(LINUX_SO): FORCE | libclang zig-toolchain
+	$(ZIGBUILD) --target $(LINUX_TARGET)
+
+# zig's Mach-O linker ignores rustc's exported-symbols list: mk/darwin-link.py, set as the
+# linker here, keeps the exports to fmi2* (cargo's --config wins over cargo-zigbuild's setting).
+target/%-apple-darwin/release/libgear_rattle.dylib: FORCE | libclang zig-toolchain
+	$(ZIGBUILD) --target $*-apple-darwin --config 'target.$*-apple-darwin.linker="$(CURDIR)/mk/darwin-link.py"'
+
+# The unstripped copy of each binary that goes into the FMU (the two darwin slices joined into
+# one universal dylib), then the stripped one. llvm-strip also re-signs the arm64 slice (ad hoc,
+# as the linker did): macOS on Apple silicon loads no code whose signature does not match.
+$(FMU_DEBUG)/linux64/GearRattle.so: $(LINUX_SO)
+$(FMU_DEBUG)/%:
+	@mkdir -p $(@D)
+	cp $^ $@
+
+$(FMU_DEBUG)/darwin64/GearRattle.dylib: $(DARWIN_SLICES) | llvm-tools
+	@mkdir -p $(@D)
+	$(LLVM_BIN)/llvm-lipo -create -output $@ $^
+
+$(FMU_STRIPPED)/%: $(FMU_DEBUG)/% | llvm-tools
+	@mkdir -p $(@D)
+	llvm-strip --strip-all -o $@ $<
+
+## test-portable: the FMU's binaries: glibc 2.17, exports, linked libraries, no debug info, size
+test-portable: fmu | llvm-tools
+	LLVM_BIN=$(LLVM_BIN) tests/portable/check.sh $(FMU)
+
+zig-toolchain: $(VENV)/.installed
+	@for a in $(DARWIN_ARCHS); do \
+		rustup target list --installed | grep -qx $$a-apple-darwin || { \
+			echo "Rust target $$a-apple-darwin missing: rustup target add $$a-apple-darwin"; \
+			rustup target add $$a-apple-darwin; }; \
+	done
+	@cargo-zigbuild --version 2>/dev/null | grep -qx 'cargo-zigbuild $(ZIGBUILD_VERSION)' || { \
+		echo "cargo-zigbuild $(ZIGBUILD_VERSION) missing: cargo install --locked cargo-zigbuild@$(ZIGBUILD_VERSION)"; \
+		cargo install --locked -j 2 cargo-zigbuild@$(ZIGBUILD_VERSION); }
+
+# Debian's llvm puts llvm-strip, llvm-objdump and llvm-nm on the PATH, llvm-lipo only in its
+# versioned directory. Evaluated when a recipe runs, after llvm-tools.
+LLVM_BIN = $(patsubst %/,%,$(lastword $(sort $(dir $(wildcard /usr/lib/llvm-*/bin/llvm-lipo)))))
+llvm-tools:
+	$(call apt_install,llvm,command -v llvm-strip >/dev/null && command -v llvm-objdump >/dev/null && command -v llvm-nm >/dev/null && compgen -G '/usr/lib/llvm-*/bin/llvm-lipo' >/dev/null)
