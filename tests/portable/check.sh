@@ -82,13 +82,8 @@ archs=$(llvm-objdump --macho --universal-headers "$DYLIB" | sed -n 's/^ *cputype
 [ "$archs" = "ARM64 X86_64 " ] || fail "darwin64 is not a universal binary of arm64 and x86_64 (slices: $archs)"
 for arch in x86_64 arm64; do
     what="darwin64 ($arch)"
-    # zig's linker also exports the two names of the Mach-O header of every dylib it links
-    # (Apple's ld keeps them private): data, not functions, which no importer looks up.
-    trie=$(llvm-objdump --macho --exports-trie --arch=$arch "$DYLIB" | awk '/^0x/ {print $2}')
-    header=$(llvm-objdump --macho --exports-trie --arch=$arch "$DYLIB" |
-        awk '$2 == "__mh_dylib_header" || $2 == "___dso_handle" {print $1}' | sort -u)
-    [ "$(wc -w <<<"$header")" -le 1 ] || fail "$what: __mh_dylib_header and ___dso_handle differ ($(echo $header))"
-    exports_are_fmi2 "$what" "$(grep -vx '__mh_dylib_header\|___dso_handle' <<<"$trie" | sed 's/^_//' | sort)"
+    exports_are_fmi2 "$what" "$(llvm-objdump --macho --exports-trie --arch=$arch "$DYLIB" |
+        awk '/^0x/ {print $2}' | sed 's/^_//' | sort)"
     libs=$(llvm-objdump --macho --dylibs-used --arch=$arch "$DYLIB" | sed -n 's/^[[:space:]]*\([^ ]*\) (compat.*/\1/p')
     # The first entry is the dylib's own install name (LC_ID_DYLIB).
     linked=$(tail -n +2 <<<"$libs")
