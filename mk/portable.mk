@@ -23,7 +23,7 @@ TEST_TARGETS += test-portable
 
 # Each binary is built as a cdylib alone (`cargo rustc --crate-type cdylib`): with the rlib
 # crate type of Cargo.toml beside it, LTO keeps every Rust function public and the linkers
-# keep them all (the packaged binaries would be 2-3 times larger).
+# keep much of them (win64 was four times larger: docs/DECISIONS.md D23).
 # cargo-zigbuild runs from target/: zig prints its include directories relative to the working
 # directory when they lie below it (the .venv does), and cargo-zigbuild hands them as they are to
 # bindgen (fmi-sys), which runs elsewhere and then finds no stddef.h. cargo still reads
