@@ -486,9 +486,12 @@ pub fn restrict_exports() {
 /// macOS: the dylib links only the libraries it calls into. The `libc` crate asks for
 /// libiconv (and cargo-zigbuild adds libcharset with it), which nothing here calls; without
 /// -dead_strip_dylibs both would be load commands, and a dylib that needs libSystem alone
-/// loads on any macOS. The exports are kept to fmi2* by mk/darwin-link.py and
+/// loads on any macOS. Its install name is `@rpath/lib<crate>.dylib`, not the path it was
+/// linked at on the build machine. The exports are kept to fmi2* by mk/darwin-link.py and
 /// mk/darwin-exports.py: zig's Mach-O linker ignores the exported-symbols list that rustc
 /// passes.
 fn apple_link_args() {
     println!("cargo:rustc-cdylib-link-arg=-Wl,-dead_strip_dylibs");
+    let crate_name = env::var("CARGO_PKG_NAME").unwrap().replace('-', "_");
+    println!("cargo:rustc-cdylib-link-arg=-Wl,-install_name,@rpath/lib{crate_name}.dylib");
 }

@@ -85,7 +85,9 @@ for arch in x86_64 arm64; do
     exports_are_fmi2 "$what" "$(llvm-objdump --macho --exports-trie --arch=$arch "$DYLIB" |
         awk '/^0x/ {print $2}' | sed 's/^_//' | sort)"
     libs=$(llvm-objdump --macho --dylibs-used --arch=$arch "$DYLIB" | sed -n 's/^[[:space:]]*\([^ ]*\) (compat.*/\1/p')
-    # The first entry is the dylib's own install name (LC_ID_DYLIB).
+    # The first entry is the dylib's own install name (LC_ID_DYLIB): no path of the build machine.
+    id=$(head -n 1 <<<"$libs")
+    [[ $id == @rpath/* ]] || fail "$what: its install name is '$id', not @rpath/..."
     linked=$(tail -n +2 <<<"$libs")
     if [ "$linked" = /usr/lib/libSystem.B.dylib ]; then
         step "$what links libSystem alone"
