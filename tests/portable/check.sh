@@ -2,7 +2,7 @@
 # The FMU's binaries as packaged, checked on Linux (run by `make test-portable`, part of
 # `make test`), with Debian's llvm tools:
 #   linux64   needs no glibc symbol version newer than 2.17 (so it loads on RHEL 7 and later);
-#   darwin64  a universal binary of an x86_64 and an arm64 slice, each for macOS 11 or older,
+#   darwin64  a universal binary of an x86_64 and an arm64 slice, each loading on macOS 11 and later,
 #             linking libSystem alone, its arm64 code signature matching its pages
 #             (macho_signature.py). Built and checked here, never run: there is no macOS here;
 #   all       export exactly the FMI 2.0 functions (Co-Simulation and Model Exchange,
