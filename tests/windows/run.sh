@@ -67,7 +67,7 @@ if [ "$exported" != "$expected" ]; then
 fi
 [ "$entries" -eq "$(wc -l <<<"$expected")" ] ||
     fail "the export address table has $entries entries for $(wc -l <<<"$expected") names (exports by ordinal only?)"
-step "exports: exactly the $entries fmi2* functions of FMI 2.0 Co-Simulation"
+step "exports: exactly the $entries fmi2* functions of FMI 2.0 (Co-Simulation and Model Exchange)"
 
 # DLLs of every Windows 10 installation that Rust's standard library (windows-gnu, MinGW's
 # msvcrt) may import; anything else (libgcc_s_seh-1.dll, libwinpthread-1.dll, vcruntime140.dll,
