@@ -1,0 +1,240 @@
+//! The FMU driven in-process through its `fmi2*` C exports, as an importer calls them: a
+//! logger that records each instance's lines in the componentEnvironment it was given, and
+//! a slave that owns one instance. Shared by the thread, memory and soak tests and the fuzz
+//! target (fuzz/), which include this file.
+#![allow(dead_code)]
+
+use fmi_sys::fmi2::*;
+use gear_rattle::contract::{Causality, GUID, Kind, VARIABLES, vr};
+use gear_rattle::ffi;
+use std::ffi::{CStr, CString, c_void};
+use std::sync::Mutex;
+
+/// One line the FMU handed to the logger.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Line {
+    pub status: fmi2Status,
+    pub instance: String,
+    pub category: String,
+    pub message: String,
+}
+
+/// What each instance's componentEnvironment points to: its lines.
+#[derive(Default)]
+pub struct Env {
+    pub lines: Mutex<Vec<Line>>,
+}
+
+/// Lossy text of a C string the FMU passed (NULL as "<NULL>").
+unsafe fn text(s: fmi2String) -> String {
+    if s.is_null() {
+        return "<NULL>".into();
+    }
+    // SAFETY: the FMU passes NUL-terminated strings valid for the call.
+    unsafe { CStr::from_ptr(s) }.to_string_lossy().into_owned()
+}
+
+/// The logger: appends the line to the Env its componentEnvironment points to. The message
+/// is a printf format whose '%' the FMU escapes, so it carries no variadic arguments and this
+/// function takes the five named ones only (on x86-64 and AArch64 Linux a variadic call
+/// passes them as to a function with exactly those parameters).
+unsafe extern "C" fn record(
+    env: fmi2ComponentEnvironment,
+    instance: fmi2String,
+    status: fmi2Status,
+    category: fmi2String,
+    message: fmi2String,
+) {
+    // SAFETY: every componentEnvironment given to the FMU here is an `Env` that outlives it.
+    let env = unsafe { &*(env as *const Env) };
+    let line = unsafe {
+        Line {
+            status,
+            instance: text(instance),
+            category: text(category),
+            message: text(message),
+        }
+    };
+    env.lines.lock().unwrap().push(line);
+}
+
+type Fixed =
+    unsafe extern "C" fn(fmi2ComponentEnvironment, fmi2String, fmi2Status, fmi2String, fmi2String);
+
+/// The callback table for one instance whose lines go to `env`.
+pub fn callbacks(env: *const Env) -> fmi2CallbackFunctions {
+    // SAFETY: see `record`: the same five leading parameters, no variadic argument read.
+    let logger = unsafe {
+        std::mem::transmute::<
+            Fixed,
+            unsafe extern "C" fn(
+                fmi2ComponentEnvironment,
+                fmi2String,
+                fmi2Status,
+                fmi2String,
+                fmi2String,
+                ...
+            ),
+        >(record)
+    };
+    fmi2CallbackFunctions {
+        logger: Some(logger),
+        allocateMemory: None,
+        freeMemory: None,
+        stepFinished: None,
+        componentEnvironment: env as *mut c_void,
+    }
+}
+
+/// The Real outputs of the contract, in its order.
+pub fn real_outputs() -> Vec<u32> {
+    VARIABLES
+        .iter()
+        .filter(|v| v.kind == Kind::Real && v.causality == Causality::Output)
+        .map(|v| v.vr)
+        .collect()
+}
+
+/// The Integer outputs of the contract, in its order.
+pub fn integer_outputs() -> Vec<u32> {
+    VARIABLES
+        .iter()
+        .filter(|v| v.kind == Kind::Integer && v.causality == Causality::Output)
+        .map(|v| v.vr)
+        .collect()
+}
+
+/// One instance, freed when dropped. Its Env is boxed so that its address, the
+/// componentEnvironment, stays put.
+pub struct Slave {
+    pub c: fmi2Component,
+    pub env: Box<Env>,
+    pub name: String,
+}
+
+// One thread at a time uses an instance, as FMI 2.0 allows.
+unsafe impl Send for Slave {}
+
+/// Panics with the call, the status and the instance's last log line unless `status` is OK.
+pub fn ok(slave: &Slave, call: &str, status: fmi2Status) {
+    if status != fmi2Status_fmi2OK {
+        let last = slave.env.lines.lock().unwrap().last().cloned();
+        panic!(
+            "{}: {call} returned {status}; last log line {last:?}",
+            slave.name
+        );
+    }
+}
+
+impl Slave {
+    pub fn new(name: &str, logging_on: bool) -> Slave {
+        let env = Box::<Env>::default();
+        let functions = callbacks(&*env);
+        let (cname, guid) = (CString::new(name).unwrap(), CString::new(GUID).unwrap());
+        // SAFETY: valid C strings and callback table, alive for the call.
+        let c = unsafe {
+            ffi::fmi2Instantiate(
+                cname.as_ptr(),
+                fmi2Type_fmi2CoSimulation,
+                guid.as_ptr(),
+                c"file:///nowhere".as_ptr(),
+                &functions,
+                0,
+                logging_on as fmi2Boolean,
+            )
+        };
+        assert!(!c.is_null(), "fmi2Instantiate({name}) returned NULL");
+        Slave {
+            c,
+            env,
+            name: name.to_string(),
+        }
+    }
+
+    /// setup, initialisation with these start values, exit: ready to step from t = 0.
+    pub fn initialise(&self, tolerance: f64, reals: &[(u32, f64)], integers: &[(u32, i32)]) {
+        unsafe {
+            ok(
+                self,
+                "fmi2SetupExperiment",
+                ffi::fmi2SetupExperiment(self.c, 1, tolerance, 0.0, 0, 0.0),
+            );
+            ok(
+                self,
+                "fmi2EnterInitializationMode",
+                ffi::fmi2EnterInitializationMode(self.c),
+            );
+            let (vr, v): (Vec<u32>, Vec<i32>) = integers.iter().copied().unzip();
+            ok(
+                self,
+                "fmi2SetInteger",
+                ffi::fmi2SetInteger(self.c, vr.as_ptr(), vr.len(), v.as_ptr()),
+            );
+            let (vr, v): (Vec<u32>, Vec<f64>) = reals.iter().copied().unzip();
+            ok(
+                self,
+                "fmi2SetReal",
+                ffi::fmi2SetReal(self.c, vr.as_ptr(), vr.len(), v.as_ptr()),
+            );
+            ok(
+                self,
+                "fmi2ExitInitializationMode",
+                ffi::fmi2ExitInitializationMode(self.c),
+            );
+        }
+    }
+
+    pub fn step(&self, t: f64, h: f64) -> fmi2Status {
+        unsafe { ffi::fmi2DoStep(self.c, t, h, 1) }
+    }
+
+    pub fn get_real(&self, vrs: &[u32]) -> Vec<f64> {
+        let mut out = vec![0.0; vrs.len()];
+        ok(self, "fmi2GetReal", unsafe {
+            ffi::fmi2GetReal(self.c, vrs.as_ptr(), vrs.len(), out.as_mut_ptr())
+        });
+        out
+    }
+
+    pub fn get_integer(&self, vrs: &[u32]) -> Vec<i32> {
+        let mut out = vec![0; vrs.len()];
+        ok(self, "fmi2GetInteger", unsafe {
+            ffi::fmi2GetInteger(self.c, vrs.as_ptr(), vrs.len(), out.as_mut_ptr())
+        });
+        out
+    }
+
+    /// Every output at once, as bits (Real outputs, then Integer ones).
+    pub fn output_bits(&self) -> Vec<u64> {
+        let reals = self.get_real(&real_outputs()).into_iter().map(f64::to_bits);
+        let integers = self
+            .get_integer(&integer_outputs())
+            .into_iter()
+            .map(|i| i as u64);
+        reals.chain(integers).collect()
+    }
+
+    pub fn lines(&self) -> Vec<Line> {
+        self.env.lines.lock().unwrap().clone()
+    }
+}
+
+impl Drop for Slave {
+    fn drop(&mut self) {
+        // SAFETY: an instance of ours, freed once.
+        unsafe { ffi::fmi2FreeInstance(self.c) }
+    }
+}
+
+/// Start values of the paper's bench scene S1 in sine mode (MODEL.md §5), with ξ(0) moved by
+/// `shift` × G so that scenes differ from one another.
+pub fn s1_start(shift: f64) -> (Vec<(u32, f64)>, Vec<(u32, i32)>) {
+    (
+        vec![
+            (vr::f_exc, 30.0),
+            (vr::A_rms, 300.0),
+            (vr::gap_start, 0.5 + shift),
+        ],
+        vec![(vr::excitation, 1)],
+    )
+}
