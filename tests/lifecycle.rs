@@ -398,3 +398,44 @@ fn an_instance_name_in_a_code_page_is_kept_as_given() {
     let lines = env.lines.lock().unwrap();
     assert_eq!(lines[0].instance, name.to_string_lossy());
 }
+
+/// A seed vector with ±Inf or NaN, or one whose product with the Jacobian overflows, is
+/// refused: fmi2OK came with NaN (found by the fuzzer).
+#[test]
+fn directional_derivatives_are_finite_or_refused() {
+    let slave = Slave::new("seed", false);
+    // Inputs mode: the main shaft's outputs follow its inputs.
+    slave.initialise(1e-6, &[], &[(vr::excitation, 0)]);
+    let unknowns = [vr::theta_M_out, vr::tau_M];
+    let mut out = [0.0; 2];
+    let call = |knowns: &[u32], dv: &[f64], out: &mut [f64; 2]| unsafe {
+        ffi::fmi2GetDirectionalDerivative(
+            slave.c,
+            unknowns.as_ptr(),
+            2,
+            knowns.as_ptr(),
+            knowns.len(),
+            dv.as_ptr(),
+            out.as_mut_ptr(),
+        )
+    };
+    for bad in [f64::NEG_INFINITY, f64::INFINITY, f64::NAN] {
+        refused(
+            &slave,
+            "fmi2GetDirectionalDerivative",
+            call(&[vr::theta_M], &[bad], &mut out),
+        );
+    }
+    let twice = [vr::theta_M, vr::theta_M];
+    refused(
+        &slave,
+        "fmi2GetDirectionalDerivative",
+        call(&twice, &[1e308, 1e308], &mut out),
+    );
+    ok(
+        &slave,
+        "fmi2GetDirectionalDerivative",
+        call(&twice, &[1.0, 0.5], &mut out),
+    );
+    assert_eq!(out[0], 1.5, "theta_M_out follows theta_M one for one");
+}

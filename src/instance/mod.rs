@@ -536,6 +536,11 @@ impl Slave for Instance {
                 )));
             }
         }
+        if let Some(dv) = dv_known.iter().find(|dv| !dv.is_finite()) {
+            return Err(FmiError::error(format!(
+                "dvKnown = {dv} refused: the seed vector must be finite"
+            )));
+        }
         let sim = self.current()?;
         for (u, out) in unknowns.iter().zip(dv_unknown) {
             let var = Self::variable(Kind::Real, *u)?;
@@ -550,6 +555,12 @@ impl Slave for Instance {
                 .zip(dv_known)
                 .map(|(k, dv)| sim.partial(*u, *k) * dv)
                 .sum();
+            if !out.is_finite() {
+                return Err(FmiError::error(format!(
+                    "the derivative of {} along dvKnown overflows ({out}): scale the seed vector down",
+                    var.name
+                )));
+            }
         }
         Ok(())
     }
