@@ -15,7 +15,7 @@ CARGO_FUZZ_VERSION := 0.13.2
 FUZZ_SCRATCH := fuzz/target/corpus-$(FUZZ_TARGET)
 FUZZ_FLAGS := -max_total_time=$(FUZZ_SECONDS) -timeout=20 -max_len=4096 -print_final_stats=1
 MEMCHECK := valgrind --tool=memcheck --leak-check=full --show-leak-kinds=definite \
-	--errors-for-leak-kinds=definite --error-exitcode=99 --quiet
+	--errors-for-leak-kinds=definite --error-exitcode=99
 HOST := $(shell rustc -vV | sed -n 's/^host: //p')
 # The lifecycle and thread tests: every fmi2 call and its error paths, 8 instances at once.
 MEMORY_TESTS := --test lifecycle --test threads
@@ -39,7 +39,7 @@ fuzz: fuzz-tools | libclang
 	mkdir -p $(FUZZ_SCRATCH)
 	cd fuzz && CARGO_BUILD_JOBS=2 cargo +nightly fuzz run $(FUZZ_TARGET) \
 		../$(FUZZ_SCRATCH) corpus/$(FUZZ_TARGET) -- $(FUZZ_FLAGS) 2>&1 \
-		| grep -v -e '^#' -e '^\s*NEW_FUNC' -e '^INFO: ' -e 'callback_log' ; exit $${PIPESTATUS[0]}
+		| grep -v -e '^#' -e '^\s*NEW_FUNC' -e '^INFO: ' -e '^"' -e 'callback_log' ; exit $${PIPESTATUS[0]}
 
 valgrind:
 	$(call apt_install,valgrind,command -v valgrind >/dev/null)

@@ -5,9 +5,9 @@
 
 mod capi;
 
-use capi::{Env, Slave, callbacks, ok, real_outputs, s1_start};
+use capi::{Env, Slave, callbacks, ok, outputs, s1_start};
 use fmi_sys::fmi2::*;
-use gear_rattle::contract::{GUID, vr};
+use gear_rattle::contract::{GUID, Kind, vr};
 use gear_rattle::ffi;
 use std::ffi::CString;
 use std::ptr::{null, null_mut};
@@ -198,7 +198,7 @@ fn refusals(slave: &Slave, t: f64) {
 /// Reads every kind of value a master reads after a step.
 fn reads(slave: &Slave, t: f64) {
     let c = slave.c;
-    let reals = slave.get_real(&real_outputs());
+    let reals = slave.get_real(&outputs(Kind::Real));
     assert!(reals.iter().all(|x| x.is_finite()));
     let (vrs, orders) = ([vr::xi, vr::tau_M], [1, 1]);
     let mut d = [0.0; 2];

@@ -21,9 +21,9 @@
 mod capi;
 
 use arbitrary::Arbitrary;
-use capi::{Env, Line, callbacks, integer_outputs, real_outputs};
+use capi::{Env, Line, callbacks, outputs};
 use fmi_sys::fmi2::*;
-use gear_rattle::contract::{GUID, LOG_CATEGORIES, VARIABLES};
+use gear_rattle::contract::{GUID, Kind, LOG_CATEGORIES, VARIABLES};
 use gear_rattle::ffi::{self, guard::Component};
 use gear_rattle::instance::{FmiState, fmu_state::serialize};
 use libfuzzer_sys::fuzz_target;
@@ -397,7 +397,7 @@ impl Harness {
     }
 
     fn read_outputs(&self, after: &str) {
-        let vrs = real_outputs();
+        let vrs = outputs(Kind::Real);
         let mut out = vec![0.0; vrs.len()];
         let s = unsafe { ffi::fmi2GetReal(self.c, vrs.as_ptr(), vrs.len(), out.as_mut_ptr()) };
         check_finite(
@@ -855,7 +855,7 @@ impl Harness {
             );
         }
         self.read_outputs("fmi2Reset and a step of S1");
-        let ints = integer_outputs();
+        let ints = outputs(Kind::Integer);
         let mut out = vec![0; ints.len()];
         assert!(status_ok(unsafe {
             ffi::fmi2GetInteger(c, ints.as_ptr(), ints.len(), out.as_mut_ptr())

@@ -86,20 +86,11 @@ pub fn callbacks(env: *const Env) -> fmi2CallbackFunctions {
     }
 }
 
-/// The Real outputs of the contract, in its order.
-pub fn real_outputs() -> Vec<u32> {
+/// The outputs of the contract of one type, in its order.
+pub fn outputs(kind: Kind) -> Vec<u32> {
     VARIABLES
         .iter()
-        .filter(|v| v.kind == Kind::Real && v.causality == Causality::Output)
-        .map(|v| v.vr)
-        .collect()
-}
-
-/// The Integer outputs of the contract, in its order.
-pub fn integer_outputs() -> Vec<u32> {
-    VARIABLES
-        .iter()
-        .filter(|v| v.kind == Kind::Integer && v.causality == Causality::Output)
+        .filter(|v| v.kind == kind && v.causality == Causality::Output)
         .map(|v| v.vr)
         .collect()
 }
@@ -206,9 +197,12 @@ impl Slave {
 
     /// Every output at once, as bits (Real outputs, then Integer ones).
     pub fn output_bits(&self) -> Vec<u64> {
-        let reals = self.get_real(&real_outputs()).into_iter().map(f64::to_bits);
+        let reals = self
+            .get_real(&outputs(Kind::Real))
+            .into_iter()
+            .map(f64::to_bits);
         let integers = self
-            .get_integer(&integer_outputs())
+            .get_integer(&outputs(Kind::Integer))
             .into_iter()
             .map(|i| i as u64);
         reals.chain(integers).collect()
