@@ -8,7 +8,10 @@ use crate::status::{FmiError, FmiResult};
 use fmi_sys::fmi2::fmi2FMUstate;
 use serde::{Deserialize, Serialize};
 
-/// What an fmi2FMUstate points to.
+/// What an fmi2FMUstate points to. `repr(C)`: the tag first, so that telling a foreign
+/// pointer reads only its first eight bytes (Rust's own layout may put the tag after the
+/// slave, thousands of bytes further).
+#[repr(C)]
 pub struct FmuState<S> {
     tag: u64,
     pub slave: S,
@@ -152,4 +155,16 @@ pub fn deserialize<S: Slave>(bytes: &[u8]) -> FmiResult<S> {
         )));
     }
     Ok(decoded.slave)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::FmuState;
+
+    /// A foreign pointer to a small object must have only its first eight bytes read: the
+    /// tag lay 4392 bytes in, past the end of such an object (AddressSanitizer saw it).
+    #[test]
+    fn the_tag_is_the_first_eight_bytes() {
+        assert_eq!(std::mem::offset_of!(FmuState<[u64; 512]>, tag), 0);
+    }
 }

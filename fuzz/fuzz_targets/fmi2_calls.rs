@@ -233,7 +233,7 @@ enum Op {
     FreeFMUstate {
         slot: u8,
     },
-    /// A pointer that is none of this FMU's states (zeroed memory).
+    /// A pointer that is none of this FMU's states: 8 zeroed bytes, as small as a tag.
     ForeignFMUstate {
         which: u8,
     },
@@ -672,7 +672,7 @@ impl Harness {
                 assert!(!status_ok(s) || self.slots[k].0.is_null());
             }
             Op::ForeignFMUstate { which } => {
-                let foreign = vec![0u64; 1024];
+                let foreign = vec![0u64; 1];
                 let p = foreign.as_ptr() as fmi2FMUstate;
                 let mut slot = p;
                 let mut size = 0;
