@@ -439,3 +439,52 @@ fn directional_derivatives_are_finite_or_refused() {
     );
     assert_eq!(out[0], 1.5, "theta_M_out follows theta_M one for one");
 }
+
+/// A run started at t = -1.8e308 and stepped to 0 in one step of 1.8e308 s, then by a
+/// subnormal step of 1.6e-314 s, overflows on the next step: that step fails with fmi2Error
+/// and no read hands out the NaN with fmi2OK (fmi2DoStep then fmi2GetReal returned fmi2OK
+/// with NaN: found by the fuzzer).
+#[test]
+fn a_step_that_overflows_fails_and_nothing_non_finite_is_read() {
+    let slave = Slave::new("overflow", false);
+    let c = slave.c;
+    unsafe {
+        ok(
+            &slave,
+            "fmi2SetupExperiment",
+            ffi::fmi2SetupExperiment(c, 0, 0.0, f64::MIN, 0, 0.0),
+        );
+        ok(
+            &slave,
+            "fmi2EnterInitializationMode",
+            ffi::fmi2EnterInitializationMode(c),
+        );
+        ok(
+            &slave,
+            "fmi2ExitInitializationMode",
+            ffi::fmi2ExitInitializationMode(c),
+        );
+    }
+    let tiny = 1.6394752844e-314;
+    ok(&slave, "fmi2DoStep", slave.step(f64::MIN, f64::MAX));
+    ok(&slave, "fmi2DoStep", slave.step(0.0, tiny));
+    // From a communication point a rounding error away, as a master may give it.
+    refused(&slave, "fmi2DoStep", slave.step(f64::from_bits(4291151302), 1e-7));
+    let vrs = outputs(Kind::Real);
+    let mut out = vec![0.0; vrs.len()];
+    let s = unsafe { ffi::fmi2GetReal(c, vrs.as_ptr(), vrs.len(), out.as_mut_ptr()) };
+    assert!(
+        s != fmi2Status_fmi2OK || out.iter().all(|x| x.is_finite()),
+        "fmi2OK with {out:?}"
+    );
+    let (orders, mut d) = ([1, 1], [0.0; 2]);
+    let xi = [vr::xi, vr::xi_dot];
+    let s = unsafe {
+        ffi::fmi2GetRealOutputDerivatives(c, xi.as_ptr(), 2, orders.as_ptr(), d.as_mut_ptr())
+    };
+    assert!(
+        s != fmi2Status_fmi2OK || d.iter().all(|x| x.is_finite()),
+        "fmi2OK with {d:?}"
+    );
+    unsafe { ok(&slave, "fmi2Reset", ffi::fmi2Reset(c)) };
+}

@@ -911,9 +911,15 @@ fn null_component(which: u8) {
 }
 
 fuzz_target!(|ops: Vec<Op>| {
+    // FUZZ_TRACE=1 (replaying a crash): each call, then the instance's state and time.
+    let trace = std::env::var_os("FUZZ_TRACE").is_some();
     let mut h = Harness::new();
     for op in ops.iter().take(64) {
         h.run(op);
+        if trace {
+            let now = h.component().map(|c| (c.instance.state, c.instance.last_successful_time()));
+            eprintln!("{op:?}\n  -> {now:?}, log {:?}", h.env.lines.lock().unwrap()[h.seen..].to_vec());
+        }
         h.check_log();
     }
     h.check_usable();

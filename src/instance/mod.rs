@@ -76,6 +76,15 @@ impl Instance {
         Ok(self.sim.as_ref().expect("built above"))
     }
 
+    /// A value that overflowed is never handed out with fmi2OK.
+    #[cold]
+    fn not_finite(vr: u32, value: f64) -> FmiError {
+        let name = contract::find(Kind::Real, vr).map_or("?", |v| v.name);
+        FmiError::error(format!(
+            "{name} = {value}: the state overflowed (inputs or times beyond what the model can represent); fmi2Reset to start over"
+        ))
+    }
+
     fn variable(kind: Kind, vr: u32) -> FmiResult<&'static contract::Variable> {
         contract::find(kind, vr).ok_or_else(|| {
             FmiError::error(format!("unknown value reference {vr} for type {kind:?}"))
@@ -363,6 +372,9 @@ impl Slave for Instance {
                 Some(value) => value,
                 None => self.real_value(*vr)?,
             };
+            if !out.is_finite() {
+                return Err(Self::not_finite(*vr, *out));
+            }
         }
         Ok(())
     }
@@ -432,7 +444,18 @@ impl Slave for Instance {
             .log
             .is_on(EVENTS)
             .then(|| (sim.impacts(), sim.stats().switches));
+        // A state that overflowed (far out on the time axis, huge inputs) is a failed step.
+        let overflowed = |sim: &Simulation| {
+            let (xi, xi_dot) = (sim.real_output(vr::xi), sim.real_output(vr::xi_dot));
+            !(xi.is_some_and(f64::is_finite) && xi_dot.is_some_and(f64::is_finite))
+        };
         match sim.step_to(t_end) {
+            Ok(()) if overflowed(sim) => {
+                self.state = FmiState::Error;
+                Err(FmiError::error(format!(
+                    "fmi2DoStep from t = {current} to {t_end} failed: the state is no longer finite (times, steps or inputs beyond what the model can represent); fmi2Reset to start over"
+                )))
+            }
             Ok(()) => {
                 self.last_successful_time = t_end;
                 self.sync_inputs();
@@ -506,7 +529,8 @@ impl Slave for Instance {
         for ((vr, order), out) in vrs.iter().zip(orders).zip(out) {
             let var = Self::variable(Kind::Real, *vr)?;
             *out = match (order, sim.real_output_derivative(*vr)) {
-                (1, Some(d)) => d,
+                (1, Some(d)) if d.is_finite() => d,
+                (1, Some(d)) => return Err(Self::not_finite(*vr, d)),
                 _ => {
                     return Err(FmiError::error(format!(
                         "no derivative of order {order} for {}: order 1 is given for {}",
