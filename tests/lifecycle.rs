@@ -5,10 +5,9 @@
 
 mod capi;
 
-use capi::{Env, Slave, callbacks, ok, outputs, s1_start};
-use fmi_sys::fmi2::*;
+use capi::{Env, Slave, callbacks, ffi, ok, outputs, s1_start};
+use fmi2_shell::fmi2::*;
 use gear_rattle::contract::{GUID, Kind, vr};
-use gear_rattle::ffi;
 use std::ffi::CString;
 use std::ptr::{null, null_mut};
 
@@ -469,7 +468,11 @@ fn a_step_that_overflows_fails_and_nothing_non_finite_is_read() {
     ok(&slave, "fmi2DoStep", slave.step(f64::MIN, f64::MAX));
     ok(&slave, "fmi2DoStep", slave.step(0.0, tiny));
     // From a communication point a rounding error away, as a master may give it.
-    refused(&slave, "fmi2DoStep", slave.step(f64::from_bits(4291151302), 1e-7));
+    refused(
+        &slave,
+        "fmi2DoStep",
+        slave.step(f64::from_bits(4291151302), 1e-7),
+    );
     let vrs = outputs(Kind::Real);
     let mut out = vec![0.0; vrs.len()];
     let s = unsafe { ffi::fmi2GetReal(c, vrs.as_ptr(), vrs.len(), out.as_mut_ptr()) };

@@ -8,10 +8,9 @@
 
 mod capi;
 
-use capi::{Slave, ok, s1_start};
-use fmi_sys::fmi2::*;
+use capi::{Slave, ffi, ok, s1_start};
+use fmi2_shell::fmi2::*;
 use gear_rattle::contract::vr;
-use gear_rattle::ffi;
 use std::ptr::null_mut;
 use std::time::Instant;
 

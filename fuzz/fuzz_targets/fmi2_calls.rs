@@ -21,11 +21,13 @@
 mod capi;
 
 use arbitrary::Arbitrary;
-use capi::{Env, Line, callbacks, outputs};
-use fmi_sys::fmi2::*;
+use capi::{Env, Line, callbacks, ffi, outputs};
+use fmi2_shell::component::Component;
+use fmi2_shell::fmi2::*;
+use fmi2_shell::fmu_state::serialize;
+use fmi2_shell::{FmiState, Slave as _};
 use gear_rattle::contract::{GUID, Kind, LOG_CATEGORIES, VARIABLES};
-use gear_rattle::ffi::{self, guard::Component};
-use gear_rattle::instance::{FmiState, fmu_state::serialize};
+use gear_rattle::instance::Instance;
 use libfuzzer_sys::fuzz_target;
 use std::ffi::CString;
 use std::ptr::{null, null_mut};
@@ -343,13 +345,13 @@ impl Harness {
         }
     }
 
-    fn component(&self) -> Option<&Component> {
+    fn component(&self) -> Option<&Component<Instance>> {
         // SAFETY: a live instance of ours.
-        (!self.c.is_null()).then(|| unsafe { &*(self.c as *const Component) })
+        (!self.c.is_null()).then(|| unsafe { &*(self.c as *const Component<Instance>) })
     }
 
     fn fmu_state_bytes(&self) -> Option<Vec<u8>> {
-        self.component().map(|c| serialize(&c.instance))
+        self.component().map(|c| serialize(&c.slave))
     }
 
     /// The log lines since the last check: printf-safe, of this instance.
@@ -393,7 +395,7 @@ impl Harness {
 
     fn time(&self) -> f64 {
         self.component()
-            .map_or(0.0, |c| c.instance.last_successful_time())
+            .map_or(0.0, |c| c.slave.last_successful_time())
     }
 
     fn read_outputs(&self, after: &str) {
@@ -770,7 +772,7 @@ impl Harness {
         if !status_ok(s)
             && self
                 .component()
-                .is_some_and(|c| c.instance.state != FmiState::Error)
+                .is_some_and(|c| c.slave.state() != FmiState::Error)
         {
             assert!(
                 self.fmu_state_bytes() == before,
@@ -917,8 +919,13 @@ fuzz_target!(|ops: Vec<Op>| {
     for op in ops.iter().take(64) {
         h.run(op);
         if trace {
-            let now = h.component().map(|c| (c.instance.state, c.instance.last_successful_time()));
-            eprintln!("{op:?}\n  -> {now:?}, log {:?}", h.env.lines.lock().unwrap()[h.seen..].to_vec());
+            let now = h
+                .component()
+                .map(|c| (c.slave.state(), c.slave.last_successful_time()));
+            eprintln!(
+                "{op:?}\n  -> {now:?}, log {:?}",
+                h.env.lines.lock().unwrap()[h.seen..].to_vec()
+            );
         }
         h.check_log();
     }

@@ -1,14 +1,173 @@
-//! The FMU driven in-process through its `fmi2*` C exports, as an importer calls them: a
-//! logger that records each instance's lines in the componentEnvironment it was given, and
-//! a slave that owns one instance. Shared by the thread, memory and soak tests and the fuzz
-//! target (fuzz/), which include this file.
+//! The FMU driven in-process through its `fmi2*` C exports, as an importer calls them: the
+//! exported symbols declared as C functions (the crate's rlib defines them), a logger that
+//! records each instance's lines in the componentEnvironment it was given, and a slave that
+//! owns one instance. Shared by the thread, memory and soak tests and the fuzz target
+//! (fuzz/), which include this file.
 #![allow(dead_code)]
 
-use fmi_sys::fmi2::*;
+use fmi2_shell::fmi2::*;
 use gear_rattle::contract::{Causality, GUID, Kind, VARIABLES, vr};
-use gear_rattle::ffi;
 use std::ffi::{CStr, CString, c_void};
 use std::sync::Mutex;
+
+/// The exports of FMI 2.0 Co-Simulation, as the standard's header declares them.
+#[allow(non_snake_case, clippy::too_many_arguments)]
+pub mod ffi {
+    use fmi2_shell::fmi2::*;
+    use std::ffi::c_char;
+    unsafe extern "C" {
+        pub fn fmi2GetTypesPlatform() -> *const c_char;
+        pub fn fmi2GetVersion() -> *const c_char;
+        pub fn fmi2Instantiate(
+            instanceName: fmi2String,
+            fmuType: fmi2Type,
+            fmuGUID: fmi2String,
+            fmuResourceLocation: fmi2String,
+            functions: *const fmi2CallbackFunctions,
+            visible: fmi2Boolean,
+            loggingOn: fmi2Boolean,
+        ) -> fmi2Component;
+        pub fn fmi2FreeInstance(c: fmi2Component);
+        pub fn fmi2SetDebugLogging(
+            c: fmi2Component,
+            on: fmi2Boolean,
+            n: usize,
+            categories: *const fmi2String,
+        ) -> fmi2Status;
+        pub fn fmi2SetupExperiment(
+            c: fmi2Component,
+            toleranceDefined: fmi2Boolean,
+            tolerance: fmi2Real,
+            startTime: fmi2Real,
+            stopTimeDefined: fmi2Boolean,
+            stopTime: fmi2Real,
+        ) -> fmi2Status;
+        pub fn fmi2EnterInitializationMode(c: fmi2Component) -> fmi2Status;
+        pub fn fmi2ExitInitializationMode(c: fmi2Component) -> fmi2Status;
+        pub fn fmi2Terminate(c: fmi2Component) -> fmi2Status;
+        pub fn fmi2Reset(c: fmi2Component) -> fmi2Status;
+        pub fn fmi2GetReal(
+            c: fmi2Component,
+            vr: *const fmi2ValueReference,
+            n: usize,
+            v: *mut fmi2Real,
+        ) -> fmi2Status;
+        pub fn fmi2GetInteger(
+            c: fmi2Component,
+            vr: *const fmi2ValueReference,
+            n: usize,
+            v: *mut fmi2Integer,
+        ) -> fmi2Status;
+        pub fn fmi2GetBoolean(
+            c: fmi2Component,
+            vr: *const fmi2ValueReference,
+            n: usize,
+            v: *mut fmi2Boolean,
+        ) -> fmi2Status;
+        pub fn fmi2GetString(
+            c: fmi2Component,
+            vr: *const fmi2ValueReference,
+            n: usize,
+            v: *mut fmi2String,
+        ) -> fmi2Status;
+        pub fn fmi2SetReal(
+            c: fmi2Component,
+            vr: *const fmi2ValueReference,
+            n: usize,
+            v: *const fmi2Real,
+        ) -> fmi2Status;
+        pub fn fmi2SetInteger(
+            c: fmi2Component,
+            vr: *const fmi2ValueReference,
+            n: usize,
+            v: *const fmi2Integer,
+        ) -> fmi2Status;
+        pub fn fmi2SetBoolean(
+            c: fmi2Component,
+            vr: *const fmi2ValueReference,
+            n: usize,
+            v: *const fmi2Boolean,
+        ) -> fmi2Status;
+        pub fn fmi2SetString(
+            c: fmi2Component,
+            vr: *const fmi2ValueReference,
+            n: usize,
+            v: *const fmi2String,
+        ) -> fmi2Status;
+        pub fn fmi2SetRealInputDerivatives(
+            c: fmi2Component,
+            vr: *const fmi2ValueReference,
+            n: usize,
+            order: *const fmi2Integer,
+            v: *const fmi2Real,
+        ) -> fmi2Status;
+        pub fn fmi2GetRealOutputDerivatives(
+            c: fmi2Component,
+            vr: *const fmi2ValueReference,
+            n: usize,
+            order: *const fmi2Integer,
+            v: *mut fmi2Real,
+        ) -> fmi2Status;
+        pub fn fmi2GetDirectionalDerivative(
+            c: fmi2Component,
+            unknowns: *const fmi2ValueReference,
+            nUnknown: usize,
+            knowns: *const fmi2ValueReference,
+            nKnown: usize,
+            dvKnown: *const fmi2Real,
+            dvUnknown: *mut fmi2Real,
+        ) -> fmi2Status;
+        pub fn fmi2DoStep(
+            c: fmi2Component,
+            t: fmi2Real,
+            h: fmi2Real,
+            noSetPrior: fmi2Boolean,
+        ) -> fmi2Status;
+        pub fn fmi2CancelStep(c: fmi2Component) -> fmi2Status;
+        pub fn fmi2GetStatus(c: fmi2Component, s: fmi2StatusKind, v: *mut fmi2Status)
+        -> fmi2Status;
+        pub fn fmi2GetRealStatus(
+            c: fmi2Component,
+            s: fmi2StatusKind,
+            v: *mut fmi2Real,
+        ) -> fmi2Status;
+        pub fn fmi2GetIntegerStatus(
+            c: fmi2Component,
+            s: fmi2StatusKind,
+            v: *mut fmi2Integer,
+        ) -> fmi2Status;
+        pub fn fmi2GetBooleanStatus(
+            c: fmi2Component,
+            s: fmi2StatusKind,
+            v: *mut fmi2Boolean,
+        ) -> fmi2Status;
+        pub fn fmi2GetStringStatus(
+            c: fmi2Component,
+            s: fmi2StatusKind,
+            v: *mut fmi2String,
+        ) -> fmi2Status;
+        pub fn fmi2GetFMUstate(c: fmi2Component, state: *mut fmi2FMUstate) -> fmi2Status;
+        pub fn fmi2SetFMUstate(c: fmi2Component, state: fmi2FMUstate) -> fmi2Status;
+        pub fn fmi2FreeFMUstate(c: fmi2Component, state: *mut fmi2FMUstate) -> fmi2Status;
+        pub fn fmi2SerializedFMUstateSize(
+            c: fmi2Component,
+            state: fmi2FMUstate,
+            size: *mut usize,
+        ) -> fmi2Status;
+        pub fn fmi2SerializeFMUstate(
+            c: fmi2Component,
+            state: fmi2FMUstate,
+            bytes: *mut fmi2Byte,
+            size: usize,
+        ) -> fmi2Status;
+        pub fn fmi2DeSerializeFMUstate(
+            c: fmi2Component,
+            bytes: *const fmi2Byte,
+            size: usize,
+            state: *mut fmi2FMUstate,
+        ) -> fmi2Status;
+    }
+}
 
 /// One line the FMU handed to the logger.
 #[derive(Clone, Debug, PartialEq)]
