@@ -154,6 +154,10 @@ pub fn deserialize<S: Slave>(bytes: &[u8]) -> FmiResult<S> {
             decoded.guid, id.guid
         )));
     }
+    decoded
+        .slave
+        .check_decoded()
+        .map_err(|e| refuse(&e.message))?;
     Ok(decoded.slave)
 }
 

@@ -2,6 +2,7 @@
 //! starting from the contract's start values.
 
 use crate::contract::{Kind, Start, Variable};
+use crate::status::{FmiError, FmiResult};
 use serde::{Deserialize, Serialize};
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -33,6 +34,25 @@ impl Values {
             }
         }
         values
+    }
+
+    /// Values decoded from a serialized FMU state: one per variable of the contract, each
+    /// finite, as fmi2SetReal leaves them.
+    pub fn check(&self, variables: &[Variable]) -> FmiResult {
+        let start = Values::start(variables);
+        if self.real.len() != start.real.len() || self.integer.len() != start.integer.len() {
+            return Err(FmiError::error(format!(
+                "{} Real and {} Integer values, the model has {} and {}",
+                self.real.len(),
+                self.integer.len(),
+                start.real.len(),
+                start.integer.len()
+            )));
+        }
+        match self.real.iter().find(|x| !x.is_finite()) {
+            Some(x) => Err(FmiError::error(format!("a value is {x}"))),
+            None => Ok(()),
+        }
     }
 
     /// `vr` must be a Real variable of the contract.

@@ -305,6 +305,20 @@ impl Slave for Instance {
         self.state
     }
 
+    fn check_decoded(&self) -> FmiResult {
+        self.values.check(contract::VARIABLES)?;
+        if !self.tau_in_rate.is_finite() {
+            return Err(FmiError::error(format!(
+                "dtau_in/dt is {}",
+                self.tau_in_rate
+            )));
+        }
+        if self.state == FmiState::StepComplete && self.sim.is_none() {
+            return Err(FmiError::error("initialised, but without a simulation"));
+        }
+        Ok(())
+    }
+
     fn set_state(&mut self, state: FmiState) {
         self.state = state;
     }
@@ -696,6 +710,29 @@ mod tests {
         let i = stepped();
         let back: Instance = deserialize(&serialize(&i)).unwrap();
         assert_eq!(serialize(&back), serialize(&i));
+    }
+
+    /// Bytes with a valid checksum but made by hand are refused when the instance they
+    /// decode to could not run: an initialised one without its simulation, values missing or
+    /// not finite (the fuzzer's mended states made fmi2ExitInitializationMode panic).
+    #[test]
+    fn hand_made_states_are_refused() {
+        let refused = |i: &Instance| deserialize::<Instance>(&serialize(i)).unwrap_err().message;
+        let mut no_sim = stepped();
+        no_sim.sim = None;
+        assert!(refused(&no_sim).contains("without a simulation"));
+        let mut nan = stepped();
+        nan.values.set_real(vr::omega_M, f64::NAN);
+        assert!(refused(&nan).contains("NaN"));
+        let mut short = stepped();
+        short.values = values_without_integers();
+        assert!(refused(&short).contains("Integer values"));
+    }
+
+    /// Values with no Integer entry, as a mended state decoded to.
+    fn values_without_integers() -> Values {
+        let bytes = postcard::to_allocvec(&(vec![0.0f64; 70], Vec::<i64>::new())).unwrap();
+        postcard::from_bytes(&bytes).unwrap()
     }
 
     /// Corrupt, cut, foreign and other-version bytes are refused with the reason.
