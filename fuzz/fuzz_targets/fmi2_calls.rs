@@ -262,6 +262,7 @@ enum Op {
     NullComponent {
         which: u8,
     },
+    Versions,
 }
 
 const SLOTS: usize = 3;
@@ -756,6 +757,13 @@ impl Harness {
                 self.buffers.push([&b[..cut], &a[cut..]].concat());
             }
             Op::NullComponent { which } => null_component(*which),
+            Op::Versions => unsafe {
+                assert_eq!(std::ffi::CStr::from_ptr(ffi::fmi2GetVersion()), c"2.0");
+                assert_eq!(
+                    std::ffi::CStr::from_ptr(ffi::fmi2GetTypesPlatform()),
+                    c"default"
+                );
+            },
         }
     }
 
