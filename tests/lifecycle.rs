@@ -321,7 +321,7 @@ fn instantiation_errors_allocate_nothing() {
     let functions = callbacks(&*env);
     let guid = CString::new(GUID).unwrap();
     let attempts: [(*const i8, fmi2Type, *const i8); 4] = [
-        (c"x".as_ptr(), fmi2Type_fmi2ModelExchange, guid.as_ptr()),
+        (c"x".as_ptr(), 7, guid.as_ptr()),
         (
             c"x".as_ptr(),
             fmi2Type_fmi2CoSimulation,

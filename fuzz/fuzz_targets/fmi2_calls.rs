@@ -425,11 +425,11 @@ impl Harness {
                 self.env = Box::default();
                 self.seen = 0;
                 let functions = callbacks(&*self.env);
-                let kind = [
-                    fmi2Type_fmi2CoSimulation,
-                    fmi2Type_fmi2ModelExchange,
-                    *fmu_type as fmi2Type,
-                ][*fmu_type as usize % 3];
+                // Co-Simulation, or a type that is neither (Model Exchange's calls are not fuzzed).
+                let kind = match fmu_type % 2 {
+                    0 => fmi2Type_fmi2CoSimulation,
+                    _ => 2 + *fmu_type as fmi2Type,
+                };
                 self.name = n
                     .as_ref()
                     .map(|s| s.to_string_lossy().into_owned())
