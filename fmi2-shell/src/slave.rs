@@ -80,6 +80,7 @@ pub trait Slave: Clone + Serialize + DeserializeOwned {
     fn check_decoded(&self) -> FmiResult {
         Ok(())
     }
+
     /// fmi2LastSuccessfulTime.
     fn last_successful_time(&self) -> f64;
 
