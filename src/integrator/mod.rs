@@ -10,6 +10,7 @@
 //! - [`radau5`]: the Radau IIA method of order 5 for stiff phases, one step at a time.
 //! - [`stiffness`]: when to hand over from one method to the other.
 //! - [`taylor`]: Taylor-series steps, where the system gives the series of its piece.
+//! - [`options`]: the tuned constants, each with its reason.
 //! - [`solver`]: the driver that reaches an exact end time, carries the step size and method
 //!   over from one call to the next, and ends steps exactly on the edges of the system's
 //!   pieces.
@@ -19,6 +20,7 @@ pub mod dopri5;
 mod entries;
 mod left_off;
 pub mod linalg;
+pub mod options;
 mod passage;
 pub mod radau5;
 pub mod roots;

@@ -15,10 +15,8 @@
 use serde::{Deserialize, Serialize};
 
 use super::left_off::LeftOff;
+use super::options::OPTIONS;
 use super::{Edge, Piecewise};
-
-/// Largest number of evaluations of the exact solution in one call's search.
-const MAX_EVALS: u64 = 100_000;
 
 /// A passage through a piece from (t0, y0), searched up to `t_clear`: no crossing in
 /// [t0, t_clear]; once `exit` is found, the piece is left through it at t_clear.
@@ -59,7 +57,7 @@ impl<const N: usize> Passage<N> {
 
     /// Extends the search until it is clear past t_end or has found the exit; returns the
     /// number of evaluations of the exact solution, or None if it needed more than
-    /// `MAX_EVALS` (a guard creeping along a bound).
+    /// `max_exit_evals` (a guard creeping along a bound).
     pub fn search<S: Piecewise<N>>(&mut self, sys: &S, t_end: f64, tol: f64) -> Option<u64> {
         let (lo, hi) = sys.piece();
         let mut evals = 0;
@@ -83,7 +81,7 @@ impl<const N: usize> Passage<N> {
                     break;
                 }
                 evals += 1;
-                if evals > MAX_EVALS {
+                if evals > OPTIONS.max_exit_evals {
                     return None;
                 }
                 self.t_clear += s;

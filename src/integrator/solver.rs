@@ -20,6 +20,7 @@ use super::control::{Controller, Tolerance};
 use super::dopri5::{self, EVALS_PER_STEP};
 use super::entries::{Entries, Entry};
 use super::left_off::LeftOff;
+use super::options::OPTIONS;
 use super::passage::Passage;
 use super::radau5::{Jacobian, RadauTrial, Stepper};
 use super::roots::illinois;
@@ -89,18 +90,6 @@ impl std::fmt::Display for SolverError {
         }
     }
 }
-
-/// The first DOPRI5 step into a piece that is rough at its start ([`Piecewise::rough_start`])
-/// is accepted at 1/20 of the tolerance. Where a force law starts at the edge as a
-/// non-integer power (contact without a smoothing band, F ∝ δ^α), the solution is not smooth
-/// at the step's start and DOPRI5's embedded estimate understates that step's error (6 to 20
-/// times for x'' = −τ^α, α in (1, 2)). The steps after the first start inside the piece,
-/// where the estimate holds again; applied at every crossing the factor only moves errors
-/// around (docs/DECISIONS.md, D6).
-const FIRST_STEP_DISTRUST: f64 = 20.0;
-
-/// Edge crossings allowed at one instant before the solver gives up.
-const MAX_CROSSINGS_AT_ONCE: u32 = 8;
 
 /// Which method steps (the FMU's `solver` parameter).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -235,7 +224,7 @@ impl<const N: usize> Solver<N> {
     pub fn with_method(tol: Tolerance<N>, method: Method) -> Self {
         Solver {
             tol,
-            max_steps: 10_000_000,
+            max_steps: OPTIONS.max_steps,
             interpolate_ends: false,
             stats: Stats::default(),
             method,
@@ -399,9 +388,9 @@ impl<const N: usize> Solver<N> {
             };
             // Reach t_end exactly, without leaving a sliver (Hairer's 1.01), or step past it.
             let step_past = self.interpolate_ends && !self.implicit;
-            let last = !step_past && *t + 1.01 * self.h >= t_end;
+            let last = !step_past && *t + OPTIONS.sliver * self.h >= t_end;
             let h = if last { t_end - *t } else { self.h };
-            if h <= 16.0 * f64::EPSILON * t.abs().max(t_end.abs()) {
+            if h <= OPTIONS.min_step_ulps * f64::EPSILON * t.abs().max(t_end.abs()) {
                 return Err(SolverError::StepTooSmall { t: *t, h });
             }
             steps += 1;
@@ -454,7 +443,7 @@ impl<const N: usize> Solver<N> {
                     crossings_here = 0;
                 } else {
                     crossings_here += 1;
-                    if crossings_here > MAX_CROSSINGS_AT_ONCE {
+                    if crossings_here > OPTIONS.crossings_at_once {
                         return Err(SolverError::Chattering { t: *t });
                     }
                 }
@@ -509,7 +498,8 @@ impl<const N: usize> Solver<N> {
             .iter()
             .filter(|b| b.is_finite())
             .fold(0.0f64, |m, b| m.max(b.abs()));
-        let tol = (1e-3 * self.tol.atol[S::GUARD]).max(16.0 * f64::EPSILON * scale);
+        let tol = (OPTIONS.exit_share * self.tol.atol[S::GUARD])
+            .max(OPTIONS.min_step_ulps * f64::EPSILON * scale);
         let evals = passage
             .search(sys, t_end, tol)
             .ok_or(SolverError::SearchStalled { t: *t })?;
@@ -544,9 +534,9 @@ impl<const N: usize> Solver<N> {
     ) -> Result<bool, SolverError> {
         let step_past = self.interpolate_ends;
         let natural = taylor::Step::length(c, &self.tol);
-        let last = !natural.is_finite() || (!step_past && *t + 1.01 * natural >= t_end);
+        let last = !natural.is_finite() || (!step_past && *t + OPTIONS.sliver * natural >= t_end);
         let h = if last { t_end - *t } else { natural };
-        if h <= 16.0 * f64::EPSILON * t.abs().max(t_end.abs()) {
+        if h <= OPTIONS.min_step_ulps * f64::EPSILON * t.abs().max(t_end.abs()) {
             return Err(SolverError::StepTooSmall { t: *t, h });
         }
         let step = taylor::Step::new(*c, h);
@@ -578,7 +568,7 @@ impl<const N: usize> Solver<N> {
                 *crossings_here = 0;
             } else {
                 *crossings_here += 1;
-                if *crossings_here > MAX_CROSSINGS_AT_ONCE {
+                if *crossings_here > OPTIONS.crossings_at_once {
                     return Err(SolverError::Chattering { t: *t });
                 }
             }
@@ -681,7 +671,7 @@ impl<const N: usize> Solver<N> {
             let trial = &*trial_buffer;
             let mut err = self.tol.norm(&trial.y0, &trial.y1, &trial.err);
             if self.just_crossed && sys.rough_start() {
-                err *= FIRST_STEP_DISTRUST;
+                err *= OPTIONS.first_step_distrust;
             }
             let verdict = self.controller.judge(err, h);
             if !verdict.accept {
