@@ -8,7 +8,7 @@
 
 use super::*;
 use gear_rattle::integrator::taylor::Coefficients;
-use gear_rattle::integrator::{Edge, Jacobian, Piecewise, System};
+use gear_rattle::integrator::{ClosedForm, Edge, Jacobian, Piecewise, System};
 use gear_rattle::physics::Region;
 use std::cell::Cell;
 
@@ -71,17 +71,8 @@ impl Piecewise<N> for Counted {
         }
         self.inner.cross(edge, t, y)
     }
-    fn has_exact(&self) -> bool {
-        self.inner.has_exact()
-    }
-    fn prepare_exact(&mut self, t0: f64, y0: &State) {
-        self.inner.prepare_exact(t0, y0)
-    }
-    fn exact(&self, t0: f64, y0: &State, t: f64) -> State {
-        self.inner.exact(t0, y0, t)
-    }
-    fn guard_acceleration_bound(&self, t0: f64, y0: &State) -> f64 {
-        self.inner.guard_acceleration_bound(t0, y0)
+    fn exact(&mut self, t0: f64, y0: &State) -> Option<impl ClosedForm<N>> {
+        self.inner.exact(t0, y0)
     }
     fn series(&self, t: f64, y: &State, c: &mut Coefficients<N>) -> bool {
         self.inner.series(t, y, c)

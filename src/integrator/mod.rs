@@ -50,6 +50,27 @@ pub trait Dense<const N: usize> {
     fn dense(&self, i: usize, theta: f64) -> f64;
 }
 
+/// A piece's solution in closed form from one start (t0, y0) ([`Piecewise::exact`]).
+pub trait ClosedForm<const N: usize> {
+    /// The state at t ≥ t0.
+    fn at(&self, t: f64) -> [f64; N];
+    /// A bound on |d² y[GUARD] / dt²| along the solution from t0 on, for as long as it stays
+    /// in the piece: what keeps the root search from stepping over a crossing.
+    fn guard_acceleration_bound(&self) -> f64;
+}
+
+/// The closed form of a system that has none.
+pub enum NoClosedForm {}
+
+impl<const N: usize> ClosedForm<N> for NoClosedForm {
+    fn at(&self, _: f64) -> [f64; N] {
+        match *self {}
+    }
+    fn guard_acceleration_bound(&self) -> f64 {
+        match *self {}
+    }
+}
+
 /// Which edge of the current piece a trajectory leaves through.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum Edge {
@@ -77,28 +98,13 @@ pub trait Piecewise<const N: usize>: System<N> {
         false
     }
 
-    /// Whether the current piece has a solution in closed form ([`Piecewise::exact`]): the
-    /// solver then takes no steps in it and finds where the solution leaves the piece by a
-    /// root search on it.
-    fn has_exact(&self) -> bool {
-        false
-    }
-
-    /// Called when a passage through the piece starts from (t0, y0): what the exact solution
-    /// from there shares between its points may be computed once here. [`Piecewise::exact`]
-    /// must give the same result whether or not this was called.
-    fn prepare_exact(&mut self, _t0: f64, _y0: &[f64; N]) {}
-
-    /// Where the piece has one: the state at t ≥ t0 from y0 at t0 in the current piece.
-    fn exact(&self, _t0: f64, y0: &[f64; N], _t: f64) -> [f64; N] {
-        *y0
-    }
-
-    /// With [`Piecewise::exact`]: a bound on |d² y[GUARD] / dt²| along the exact solution
-    /// from (t0, y0) on, for as long as it stays in the piece. It is what keeps the root
-    /// search from stepping over a crossing.
-    fn guard_acceleration_bound(&self, _t0: f64, _y0: &[f64; N]) -> f64 {
-        f64::INFINITY
+    /// Where the current piece has a solution in closed form (the free flight): that
+    /// solution from (t0, y0). The solver then takes no steps in the piece; it follows the
+    /// solution and finds where it leaves the piece by a root search on it (see `passage`).
+    /// The system may keep what the solution's points share, for the next call from the
+    /// same start. None (the default): the piece is crossed by steps.
+    fn exact(&mut self, _t0: f64, _y0: &[f64; N]) -> Option<impl ClosedForm<N>> {
+        None::<NoClosedForm>
     }
 
     /// Where the current piece's solution is analytic and the system can form its Taylor

@@ -6,7 +6,7 @@
 //! dense output, so that the trajectory and its cost do not depend on how often the caller
 //! asks (communication steps of 10 µs take the steps of 10 ms ones, bit for bit).
 //!
-//! A piece with a solution in closed form ([`Piecewise::has_exact`]) is crossed without
+//! A piece with a solution in closed form ([`Piecewise::exact`]) is crossed without
 //! steps: `passage` searches where that solution leaves the piece, and serves the end times
 //! inside it from the solution itself.
 //!
@@ -21,7 +21,7 @@ use super::dopri5::{self, EVALS_PER_STEP};
 use super::entries::{Entries, Entry};
 use super::left_off::LeftOff;
 use super::options::OPTIONS;
-use super::passage::Passage;
+use super::passage::{self, Passage};
 use super::radau5::{Jacobian, RadauTrial, Stepper};
 use super::roots::illinois;
 use super::stiffness::{Switch, spectral_radius, stiffness};
@@ -269,7 +269,7 @@ impl<const N: usize> Solver<N> {
     /// cannot fail. False, with nothing changed, otherwise.
     pub fn serve<S: Piecewise<N>>(
         &mut self,
-        sys: &S,
+        sys: &mut S,
         t: &mut f64,
         y: &mut [f64; N],
         t_end: f64,
@@ -285,8 +285,11 @@ impl<const N: usize> Solver<N> {
             && p.continued_by(*t, y)
             && t_end <= p.t_clear
         {
-            self.stats.exact_evals += p.serve(sys, t, y, t_end);
-            return true;
+            let (t0, y0) = (p.t0, p.y0);
+            if let Some(exact) = sys.exact(t0, &y0) {
+                self.stats.exact_evals += p.serve(&exact, t, y, t_end);
+                return true;
+            }
         }
         false
     }
@@ -337,8 +340,8 @@ impl<const N: usize> Solver<N> {
             if !self.just_crossed && sys.settle(*t, y) > 0 {
                 self.invalidate();
             }
-            if sys.has_exact() {
-                if self.pass(sys, t, y, t_end)? {
+            if let Some(passed) = self.pass(sys, t, y, t_end)? {
+                if passed {
                     continue;
                 }
                 return Ok(());
@@ -477,44 +480,44 @@ impl<const N: usize> Solver<N> {
         Ok(())
     }
 
-    /// Through a piece with an exact solution (see `passage`): to t_end, or to where the
-    /// solution leaves the piece, crossing that edge (true). The passage is kept for the next
-    /// call while it continues.
+    /// Through a piece in closed form (see `passage`): to t_end, where the passage is kept
+    /// for the next call (false), or to where the solution leaves the piece, crossing that
+    /// edge (true). None if the piece has no closed form.
     fn pass<S: Piecewise<N>>(
         &mut self,
         sys: &mut S,
         t: &mut f64,
         y: &mut [f64; N],
         t_end: f64,
-    ) -> Result<bool, SolverError> {
-        let mut passage = match self.passage.take() {
-            Some(p) if p.continued_by(*t, y) => p,
-            _ => Passage::new(sys, *t, y),
+    ) -> Result<Option<bool>, SolverError> {
+        let continued = match self.passage {
+            Some(p) if p.continued_by(*t, y) => Some(p),
+            _ => None,
         };
-        // Close enough to an edge to cross it: a thousandth of the guard's absolute
-        // tolerance, or a few rounding errors of the edges.
-        let (lo, hi) = sys.piece();
-        let scale = [lo, hi]
-            .iter()
-            .filter(|b| b.is_finite())
-            .fold(0.0f64, |m, b| m.max(b.abs()));
-        let tol = (OPTIONS.exit_share * self.tol.atol[S::GUARD])
-            .max(OPTIONS.min_step_ulps * f64::EPSILON * scale);
+        let (t0, y0) = continued.map_or((*t, *y), |p| (p.t0, p.y0));
+        let piece = sys.piece();
+        let Some(exact) = sys.exact(t0, &y0) else {
+            return Ok(None);
+        };
+        let mut passage = continued.unwrap_or_else(|| Passage::new(t0, &y0, &exact));
+        self.passage = None;
+        let tol = passage::exit_tolerance(piece, self.tol.atol[S::GUARD]);
         let evals = passage
-            .search(sys, t_end, tol)
+            .search::<S>(&exact, piece, t_end, tol)
             .ok_or(SolverError::SearchStalled { t: *t })?;
         self.stats.exact_evals += evals;
         match passage.exit {
             Some(edge) if passage.t_clear <= t_end => {
+                drop(exact);
                 *t = passage.t_clear;
                 *y = passage.y_clear;
                 self.cross(sys, edge, *t, y);
-                Ok(true)
+                Ok(Some(true))
             }
             _ => {
-                self.stats.exact_evals += passage.serve(sys, t, y, t_end);
+                self.stats.exact_evals += passage.serve(&exact, t, y, t_end);
                 self.passage = Some(passage);
-                Ok(false)
+                Ok(Some(false))
             }
         }
     }
