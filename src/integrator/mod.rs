@@ -1,19 +1,17 @@
-//! Adaptive Runge-Kutta integration of piecewise-smooth ODEs, knowing nothing of gears.
+//! Integration of piecewise-smooth ODEs, knowing nothing of gears.
 //!
-//! - [`dopri5`]: the Dormand-Prince 5(4) pair with its 4th-order dense output (Hairer,
-//!   Nørsett & Wanner, *Solving ODEs I*, II.5), one step at a time.
-//! - [`control`]: the error norm (atol + rtol·|y| per component) and the step-size controller.
+//! - [`solver`]: the driver that reaches an exact end time piece by piece, ends steps exactly
+//!   on the edges of the system's pieces, and carries what it knows from one call to the next.
+//! - One stepper per kind of piece: `passage` for pieces with a solution in closed form (the
+//!   free flight), crossed without steps, their exit found by a root search that cannot step
+//!   over a crossing; [`taylor`] for pieces whose Taylor series the system gives;
+//!   `runge_kutta` for the others: [`dopri5`] (the Dormand-Prince 5(4) pair with its
+//!   4th-order dense output, Hairer, Nørsett & Wanner, *Solving ODEs I*, II.5) with the
+//!   controller of [`control`], or [`radau5`] (Radau IIA of order 5) while the problem is
+//!   stiff ([`stiffness`]), the first step into a piece learnt from earlier entries
+//!   (`entries`).
 //! - [`roots`]: the Illinois root finder used to locate edges on the dense output.
-//! - `entries`: the first step into a piece, from what was learnt of earlier entries.
-//! - `passage`: pieces with a solution in closed form (the free flight), crossed without
-//!   steps, their exit found by a root search that cannot step over a crossing.
-//! - [`radau5`]: the Radau IIA method of order 5 for stiff phases, one step at a time.
-//! - [`stiffness`]: when to hand over from one method to the other.
-//! - [`taylor`]: Taylor-series steps, where the system gives the series of its piece.
 //! - [`options`]: the tuned constants, each with its reason.
-//! - [`solver`]: the driver that reaches an exact end time, carries the step size and method
-//!   over from one call to the next, and ends steps exactly on the edges of the system's
-//!   pieces.
 
 pub mod control;
 pub mod dopri5;
@@ -24,6 +22,7 @@ pub mod options;
 mod passage;
 pub mod radau5;
 pub mod roots;
+mod runge_kutta;
 pub mod serde_array;
 pub mod solver;
 pub mod stiffness;

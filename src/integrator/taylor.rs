@@ -37,6 +37,11 @@ impl<const N: usize> Step<N> {
         step
     }
 
+    /// The same series cut to end at θ ∈ [0, 1] of the step.
+    pub fn cut(&self, theta: f64) -> Self {
+        Step::new(self.c, theta * self.h)
+    }
+
     /// The longest step for the tolerance: for each controlled component with weight
     /// w = atol + rtol·|y0|, the last two terms |c_k| τ^k must stay within SHARE·w.
     pub fn length(c: &Coefficients<N>, tol: &Tolerance<N>) -> f64 {
