@@ -388,9 +388,13 @@ contact_pieces!(
             }
         };
         self.flight_start = Some(start);
+        let (params, excitation) = (&self.dynamics.params, &self.excitation);
         Some(FreeFlight {
-            rattle: self,
-            start,
+            flight: Flight {
+                params,
+                excitation,
+                start,
+            },
             t0,
             y0: *y0,
         })
@@ -456,49 +460,35 @@ impl Rattle {
     }
 }
 
-impl Rattle {
-    /// ∫ a² dτ over a free flight of length τ that ends in `f`: in the gap
-    /// a = (r_L / I_L) (B − C u) with u = ω_L − ω_S, so the integral is
-    /// (r_L / I_L)² (B² τ − 2 B C ∫u dτ + C ∫C u² dτ), the last being the lubricant's energy.
-    fn flight_a2(&self, tau: f64, f: &FlightState) -> f64 {
-        let p = &self.dynamics.params;
-        let lever = p.r_L / p.I_L;
-        lever * lever * (p.B * (p.B * tau - 2.0 * p.C * f.slip_integral) + p.C * f.e_lubricant)
-    }
+/// ∫ a² dτ over a free flight of length τ that ends in `f`: in the gap
+/// a = (r_L / I_L) (B − C u) with u = ω_L − ω_S, so the integral is
+/// (r_L / I_L)² (B² τ − 2 B C ∫u dτ + C ∫C u² dτ), the last being the lubricant's energy.
+fn flight_a2(p: &GearParams, tau: f64, f: &FlightState) -> f64 {
+    let lever = p.r_L / p.I_L;
+    lever * lever * (p.B * (p.B * tau - 2.0 * p.C * f.slip_integral) + p.C * f.e_lubricant)
 }
 
 /// The free flight from one start (t0, y0), as the integrator follows it.
 struct FreeFlight<'a> {
-    rattle: &'a Rattle,
-    start: FlightStart,
+    flight: Flight<'a>,
     t0: f64,
     y0: State,
 }
 
-impl FreeFlight<'_> {
-    fn flight(&self) -> Flight<'_> {
-        Flight {
-            params: &self.rattle.dynamics.params,
-            excitation: &self.rattle.excitation,
-            start: self.start,
-        }
-    }
-}
-
 impl ClosedForm<N> for FreeFlight<'_> {
     fn at(&self, t: f64) -> State {
-        let f = self.flight().at(t);
+        let f = self.flight.at(t);
         let mut y = self.y0;
         y[XI] = f.xi;
         y[XI_DOT] = f.xi_dot;
         y[E_LUBRICANT] += f.e_lubricant;
-        y[E_CONTACT + quadrature::A2] += self.rattle.flight_a2(t - self.t0, &f);
+        y[E_CONTACT + quadrature::A2] += flight_a2(self.flight.params, t - self.t0, &f);
         // No contact force in the gap: E_CONTACT, W_SHAFT, ∫F and ∫F² stay.
         y
     }
 
     fn guard_acceleration_bound(&self) -> f64 {
-        self.flight().acceleration_bound()
+        self.flight.acceleration_bound()
     }
 }
 

@@ -13,7 +13,7 @@ use super::options::OPTIONS;
 use super::radau5::{Jacobian, RadauTrial, Stepper};
 use super::solver::{Budget, SolverError, Stats, locate_edge};
 use super::stiffness::{Switch, spectral_radius, stiffness};
-use super::{Edge, Piecewise, System};
+use super::{Dense, Edge, Piecewise, System};
 
 /// Which method steps (the FMU's `solver` parameter).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -40,9 +40,6 @@ pub(super) struct Accepted<const N: usize> {
     /// Cut short to end on the call's end time.
     pub last: bool,
     pub y1: [f64; N],
-    /// Taken by DOPRI5: the trial buffer holds the step (its last stage is f(t + h, y1); its
-    /// dense output serves the points inside it). Else by Radau IIA.
-    pub explicit: bool,
     /// f at the step's start, for a step redone from there.
     k1: [f64; N],
     h_next: f64,
@@ -160,57 +157,43 @@ impl<const N: usize> RungeKutta<N> {
             _ => None,
         };
         let (h, last) = budget.step(t, t_end, self.h, past)?;
-        let (lo, hi) = sys.piece();
-        let guard = (S::GUARD, S::RATE);
-        let judged = match self.mode {
+        let piece = sys.piece();
+        let (verdict, y1, edge, h_rho) = match self.mode {
             Mode::Radau => {
                 let trial = self.implicit_step(sys, (t, y, &k1), h, stats);
                 let verdict = self.radau.judge(&trial);
-                if verdict.accept {
-                    sys.observe(t, h, &trial);
-                    let edge = locate_edge(&trial, guard, lo, hi);
-                    Ok((trial.y1, verdict.h_next, edge, 0.0))
-                } else {
-                    Err(verdict.h_next)
-                }
+                let edge = verdict.accept.then(|| observed(sys, (t, h), &trial, piece));
+                (verdict, trial.y1, edge, 0.0)
             }
             Mode::Dopri5 => {
                 explicit_step(sys, (t, y, &k1), h, tol, trial, stats);
-                let trial = &*trial;
                 let mut err = tol.norm(&trial.y0, &trial.y1, &trial.err);
                 if rough {
                     err *= OPTIONS.first_step_distrust;
                 }
                 let verdict = self.controller.judge(err, h);
-                if verdict.accept {
-                    sys.observe(t, h, trial);
-                    let edge = locate_edge(trial, guard, lo, hi);
-                    let h_rho = if self.method == Method::Auto {
-                        stiffness(trial, tol)
-                    } else {
-                        0.0
-                    };
-                    Ok((trial.y1, verdict.h_next, edge, h_rho))
-                } else {
-                    Err(verdict.h_next)
-                }
+                let edge = verdict
+                    .accept
+                    .then(|| observed(sys, (t, h), &*trial, piece));
+                let auto = verdict.accept && self.method == Method::Auto;
+                (
+                    verdict,
+                    trial.y1,
+                    edge,
+                    if auto { stiffness(trial, tol) } else { 0.0 },
+                )
             }
         };
         if let Some((entry, carried)) = entering {
-            let wanted = judged.map_or_else(|h_next| h_next, |(_, h_next, _, _)| h_next);
-            self.entries.learn(&entry, carried, wanted);
+            self.entries.learn(&entry, carried, verdict.h_next);
         }
-        let (y1, h_next, edge, h_rho) = match judged {
-            Ok(judged) => judged,
-            Err(h_next) => {
-                stats.rejected += 1;
-                self.h = h_next;
-                return Ok(None);
-            }
+        let Some(edge) = edge else {
+            stats.rejected += 1;
+            self.h = verdict.h_next;
+            return Ok(None);
         };
         stats.accepted += 1;
-        let explicit = self.mode == Mode::Dopri5;
-        if !explicit {
+        if self.mode == Mode::Radau {
             stats.implicit_steps += 1;
         }
         Ok(Some(Accepted {
@@ -218,8 +201,7 @@ impl<const N: usize> RungeKutta<N> {
             last,
             y1,
             k1,
-            explicit,
-            h_next,
+            h_next: verdict.h_next,
             edge,
             h_rho,
         }))
@@ -261,15 +243,15 @@ impl<const N: usize> RungeKutta<N> {
         self.h = step.h_next.max(theta * step.h);
     }
 
-    /// The accepted `step` is taken whole (its DOPRI5 trial in `trial`): the next step's
-    /// start and size, and the hand-over of [`Method::Auto`].
+    /// The accepted `step` is taken whole (a DOPRI5 step in `trial`, whose last stage is
+    /// f at its end): the next step's start and size, and the hand-over of [`Method::Auto`].
     pub fn ended_inside(
         &mut self,
         step: &Accepted<N>,
         trial: &dopri5::Trial<N>,
         stats: &mut Stats,
     ) {
-        self.k1 = step.explicit.then(|| *trial.k_end());
+        self.k1 = (self.mode == Mode::Dopri5).then(|| *trial.k_end());
         // A step cut short to land on t_end says little about the natural step size.
         self.h = if step.last {
             step.h_next.max(self.h)
@@ -346,6 +328,18 @@ impl<const N: usize> RungeKutta<N> {
             }
         }
     }
+}
+
+/// An accepted step from t of length h, shown to the system ([`Piecewise::observe`]): the edge of
+/// `piece` it leaves through, if any.
+fn observed<S: Piecewise<N>, D: Dense<N>, const N: usize>(
+    sys: &mut S,
+    (t, h): (f64, f64),
+    step: &D,
+    (lo, hi): (f64, f64),
+) -> Option<(Edge, f64)> {
+    sys.observe(t, h, step);
+    locate_edge(step, (S::GUARD, S::RATE), lo, hi)
 }
 
 /// A DOPRI5 trial from (t, y, f(t, y)) into `trial`, with its work counted.

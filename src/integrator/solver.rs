@@ -146,15 +146,6 @@ enum Taken<const N: usize> {
     RungeKutta(Accepted<N>),
 }
 
-impl<const N: usize> Taken<N> {
-    fn h(&self) -> f64 {
-        match self {
-            Taken::Series(s, _) => s.h,
-            Taken::RungeKutta(a) => a.h,
-        }
-    }
-}
-
 /// What a call keeps for the next one, to serve end times from if it continues from where
 /// this one left off.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -253,10 +244,6 @@ impl<const N: usize> Solver<N> {
             just_crossed: false,
             kept: None,
         }
-    }
-
-    pub fn tolerance(&self) -> &Tolerance<N> {
-        &self.tol
     }
 
     /// True while Radau IIA steps.
@@ -445,13 +432,12 @@ impl<const N: usize> Solver<N> {
         budget: &mut Budget,
         trial: &mut dopri5::Trial<N>,
     ) -> Result<Flow, SolverError> {
-        let h = step.h();
-        let (y1, edge) = match step {
+        let (h, y1, edge) = match step {
             Taken::Series(s, _) => {
                 let (lo, hi) = sys.piece();
-                (s.y1, locate_edge(s, (S::GUARD, S::RATE), lo, hi))
+                (s.h, s.y1, locate_edge(s, (S::GUARD, S::RATE), lo, hi))
             }
-            Taken::RungeKutta(a) => (a.y1, a.edge),
+            Taken::RungeKutta(a) => (a.h, a.y1, a.edge),
         };
         let work = (&self.tol, &mut self.stats);
         if let Some((edge, theta)) = edge {
