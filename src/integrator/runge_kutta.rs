@@ -40,8 +40,6 @@ pub(super) struct Accepted<const N: usize> {
     /// Cut short to end on the call's end time.
     pub last: bool,
     pub y1: [f64; N],
-    /// f at the step's start, for a step redone from there.
-    k1: [f64; N],
     h_next: f64,
     /// The edge the step leaves its piece through, and at which fraction of the step.
     pub edge: Option<(Edge, f64)>,
@@ -200,7 +198,6 @@ impl<const N: usize> RungeKutta<N> {
             h,
             last,
             y1,
-            k1,
             h_next: verdict.h_next,
             edge,
             h_rho,
@@ -208,7 +205,7 @@ impl<const N: usize> RungeKutta<N> {
     }
 
     /// The accepted `step` from (t, y) redone to end at θ, on the edge inside it (a DOPRI5
-    /// step into `trial`); None if Radau's Newton iteration fails on it (the next attempt's
+    /// step into `trial`; f at (t, y) is known from the step); None if Radau's Newton iteration fails on it (the next attempt's
     /// size set).
     #[allow(clippy::too_many_arguments)]
     pub fn redo<S: Piecewise<N> + Jacobian<N>>(
@@ -221,9 +218,10 @@ impl<const N: usize> RungeKutta<N> {
         trial: &mut dopri5::Trial<N>,
     ) -> Option<[f64; N]> {
         let h = theta * step.h;
+        let k1 = self.derivative(sys, t, y, stats);
         match self.mode {
             Mode::Radau => {
-                let trial = self.implicit_step(sys, (t, y, &step.k1), h, stats);
+                let trial = self.implicit_step(sys, (t, y, &k1), h, stats);
                 if !trial.converged() {
                     self.h = 0.5 * theta * step.h;
                     return None;
@@ -231,7 +229,7 @@ impl<const N: usize> RungeKutta<N> {
                 Some(trial.y1)
             }
             Mode::Dopri5 => {
-                explicit_step(sys, (t, y, &step.k1), h, tol, trial, stats);
+                explicit_step(sys, (t, y, &k1), h, tol, trial, stats);
                 Some(trial.y1)
             }
         }

@@ -139,9 +139,9 @@ impl Budget {
 }
 
 /// An accepted step, whichever stepper took it.
-enum Taken<const N: usize> {
+enum Taken<'a, const N: usize> {
     /// A Taylor step, its polynomial its own dense output; cut to end on t_end if `last`.
-    Series(taylor::Step<N>, bool),
+    Series(&'a taylor::Step<N>, bool),
     /// A DOPRI5 step (in the trial buffer) or a Radau IIA step.
     RungeKutta(Accepted<N>),
 }
@@ -318,15 +318,16 @@ impl<const N: usize> Solver<N> {
                 }
             }
             let past = self.interpolate_ends && self.rk.mode == Mode::Dopri5;
+            let series_step;
             let step = if self.rk.mode == Mode::Dopri5 && sys.series(*t, y, &mut series) {
                 let natural = taylor::Step::length(&series, &self.tol);
                 let (h, last) = budget.step(*t, t_end, natural, past)?;
-                let step = taylor::Step::new(series, h);
-                sys.observe(*t, h, &step);
+                series_step = taylor::Step::new(series, h);
+                sys.observe(*t, h, &series_step);
                 self.stats.accepted += 1;
                 self.stats.series_steps += 1;
                 self.rk.stepped_by_series();
-                Taken::Series(step, last)
+                Taken::Series(&series_step, last)
             } else {
                 let rough = self.just_crossed && sys.rough_start();
                 let work = (&self.tol, &mut self.stats, &mut budget);
@@ -435,7 +436,7 @@ impl<const N: usize> Solver<N> {
         let (h, y1, edge) = match step {
             Taken::Series(s, _) => {
                 let (lo, hi) = sys.piece();
-                (s.h, s.y1, locate_edge(s, (S::GUARD, S::RATE), lo, hi))
+                (s.h, s.y1, locate_edge(*s, (S::GUARD, S::RATE), lo, hi))
             }
             Taken::RungeKutta(a) => (a.h, a.y1, a.edge),
         };
@@ -487,7 +488,7 @@ impl<const N: usize> Solver<N> {
         };
         if past && *t + h > t_end {
             let dense = match step {
-                Taken::Series(s, _) => Interpolant::Taylor(*s),
+                Taken::Series(s, _) => Interpolant::Taylor(**s),
                 Taken::RungeKutta(_) => Interpolant::Dopri5(trial.continuous()),
             };
             self.keep(dense, h, y1, None, (t, y), t_end);

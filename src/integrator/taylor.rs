@@ -31,6 +31,7 @@ pub struct Step<const N: usize> {
 
 impl<const N: usize> Step<N> {
     /// The step of length h from the series `c` about its start.
+    #[inline]
     pub fn new(c: Coefficients<N>, h: f64) -> Self {
         let mut step = Step { h, c, y1: [0.0; N] };
         step.y1 = step.at(1.0);
