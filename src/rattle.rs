@@ -374,29 +374,17 @@ contact_pieces!(
         if self.region != Region::Gap {
             return None;
         }
-        let start = match self.flight_start {
-            Some(start) if start.is_from(t0, y0[XI], y0[XI_DOT]) => start,
-            _ => {
-                Flight::new(
-                    &self.dynamics.params,
-                    &self.excitation,
-                    t0,
-                    y0[XI],
-                    y0[XI_DOT],
-                )
-                .start
-            }
-        };
-        self.flight_start = Some(start);
-        let (params, excitation) = (&self.dynamics.params, &self.excitation);
+        if !matches!(self.flight_start, Some(s) if s.is_from(t0, y0[XI], y0[XI_DOT])) {
+            let (params, excitation) = (&self.dynamics.params, &self.excitation);
+            let flight = Flight::new(params, excitation, t0, y0[XI], y0[XI_DOT]);
+            self.flight_start = Some(flight.start);
+        }
+        let rattle = &*self;
         Some(FreeFlight {
-            flight: Flight {
-                params,
-                excitation,
-                start,
-            },
+            rattle,
+            start: rattle.flight_start.as_ref()?,
             t0,
-            y0: *y0,
+            y0,
         })
     },
     /// In full contact, entered through a band (ε > 0, so that δ stays away from the
@@ -469,26 +457,38 @@ fn flight_a2(p: &GearParams, tau: f64, f: &FlightState) -> f64 {
 }
 
 /// The free flight from one start (t0, y0), as the integrator follows it.
-struct FreeFlight<'a> {
-    flight: Flight<'a>,
+struct FreeFlight<'r, 'y> {
+    rattle: &'r Rattle,
+    start: &'r FlightStart,
     t0: f64,
-    y0: State,
+    y0: &'y State,
 }
 
-impl ClosedForm<N> for FreeFlight<'_> {
+impl FreeFlight<'_, '_> {
+    fn flight(&self) -> Flight<'_> {
+        let (params, excitation) = (&self.rattle.dynamics.params, &self.rattle.excitation);
+        Flight {
+            params,
+            excitation,
+            start: *self.start,
+        }
+    }
+}
+
+impl ClosedForm<N> for FreeFlight<'_, '_> {
     fn at(&self, t: f64) -> State {
-        let f = self.flight.at(t);
-        let mut y = self.y0;
+        let f = self.flight().at(t);
+        let mut y = *self.y0;
         y[XI] = f.xi;
         y[XI_DOT] = f.xi_dot;
         y[E_LUBRICANT] += f.e_lubricant;
-        y[E_CONTACT + quadrature::A2] += flight_a2(self.flight.params, t - self.t0, &f);
+        y[E_CONTACT + quadrature::A2] += flight_a2(&self.rattle.dynamics.params, t - self.t0, &f);
         // No contact force in the gap: E_CONTACT, W_SHAFT, ∫F and ∫F² stay.
         y
     }
 
     fn guard_acceleration_bound(&self) -> f64 {
-        self.flight.acceleration_bound()
+        self.flight().acceleration_bound()
     }
 }
 
