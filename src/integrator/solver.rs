@@ -280,11 +280,10 @@ impl<const N: usize> Solver<N> {
                 true
             }
             Some(Kept::Passage(p)) if p.continued_by(*t, y) && t_end <= p.t_clear => {
-                let (t0, y0) = (p.t0, p.y0);
-                let Some(exact) = sys.exact(t0, &y0) else {
+                let Some(evals) = p.serve(sys, t, y, t_end) else {
                     return false;
                 };
-                self.stats.exact_evals += p.serve(&exact, t, y, t_end);
+                self.stats.exact_evals += evals;
                 true
             }
             _ => false,
@@ -397,16 +396,16 @@ impl<const N: usize> Solver<N> {
             .search::<S>(&exact, piece, t_end, tol)
             .ok_or(SolverError::SearchStalled { t: *t })?;
         self.stats.exact_evals += evals;
+        drop(exact);
         match passage.exit {
             Some(edge) if passage.t_clear <= t_end => {
-                drop(exact);
                 *t = passage.t_clear;
                 *y = passage.y_clear;
                 self.cross(sys, edge, *t, y);
                 Ok(Some(Flow::Go))
             }
             _ => {
-                self.stats.exact_evals += passage.serve(&exact, t, y, t_end);
+                self.stats.exact_evals += passage.serve(sys, t, y, t_end).unwrap_or(0);
                 self.kept = Some(Kept::Passage(passage));
                 Ok(Some(Flow::Done))
             }
