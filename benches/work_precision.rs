@@ -31,9 +31,9 @@ use std::path::{Path, PathBuf};
 use differential_equations::methods::ExplicitRungeKutta;
 use fmi::fmi2::import::Fmi2Import;
 use fmi::fmi2::instance::{CoSimulation, Common};
+use fmi2_shell::values::Values;
 use gear_rattle::contract::vr;
 use gear_rattle::instance::Simulation;
-use gear_rattle::instance::values::Values;
 use gear_rattle::integrator::Solver;
 use gear_rattle::physics::{Dynamics, Excitation, GearParams, Sine};
 use gear_rattle::rattle::{N, Rattle, State, XI, XI_DOT};
@@ -299,11 +299,14 @@ fn atol(sc: &Scene, rtol: f64) -> [f64; N] {
         1e30,
         1e30,
         1e30,
+        1e30,
+        1e30,
+        1e30,
     ]
 }
 
 fn rtols(rtol: f64) -> [f64; N] {
-    [rtol, rtol, 0.0, 0.0, 0.0]
+    [rtol, rtol, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]
 }
 
 /// The explicit Runge-Kutta pairs of differential-equations: DOPRI5 or DOP853.
@@ -371,7 +374,7 @@ fn sampling(comm: f64) -> (usize, usize) {
 }
 
 fn fmu_values(sc: &Scene) -> Values {
-    let mut v = Values::start();
+    let mut v = Values::start(gear_rattle::contract::VARIABLES);
     v.set_integer(vr::excitation, 1);
     v.set_real(vr::A_rms, sc.A_rms);
     v.set_real(vr::f_exc, sc.f_exc);
@@ -386,7 +389,7 @@ fn run_steps(sc: &Scene, rtol: f64, comm: f64) -> Outcome {
     let n = (sc.t_end / comm).round() as usize;
     let (every, stride) = sampling(comm);
     let start = cpu_now();
-    let mut sim = Simulation::new(&fmu_values(sc), 0.0, rtol).map_err(|e| e.message)?;
+    let mut sim = Simulation::new(&fmu_values(sc), 0.0, 0.0, rtol).map_err(|e| e.message)?;
     let mut run = empty_run(n / every + 1);
     let record = |run: &mut Run, sim: &Simulation| {
         run.xi.push(sim.real_output(vr::xi).unwrap());

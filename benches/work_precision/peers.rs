@@ -87,6 +87,9 @@ impl UserRhs {
             f_c * v,
             p.C * (om_l - p.omega_S) * (om_l - p.omega_S),
             -p.r_M * f * om_m,
+            0.0,
+            0.0,
+            0.0,
         ]
     }
 }

@@ -75,7 +75,7 @@ impl<S: GearPair<N> + Jacobian<N> + Copy, const N: usize> Stepped<S, N> {
     /// call served from the solver's kept step cannot fail and needs no copy to roll back to
     /// (at 10 µs communication steps most are).
     fn advance_to(&mut self, t: &mut f64, t_end: f64) -> Result<(), SolverError> {
-        if self.solver.serve(&self.system, t, &mut self.y, t_end) {
+        if self.solver.serve(&mut self.system, t, &mut self.y, t_end) {
             return Ok(());
         }
         let (before, t_before) = (*self, *t);

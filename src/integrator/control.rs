@@ -3,6 +3,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::options::OPTIONS;
 use crate::math;
 
 /// Tolerances: the error of component i is weighed by atol[i] + rtol·max(|y0_i|, |y1_i|).
@@ -30,12 +31,11 @@ impl<const N: usize> Tolerance<N> {
     }
 }
 
-const SAFETY: f64 = 0.9;
-const BETA: f64 = 0.04;
+const SAFETY: f64 = OPTIONS.safety;
+const BETA: f64 = OPTIONS.beta;
 const EXPONENT: f64 = 0.2 - BETA * 0.75;
-/// Largest shrink (1/10) and growth (×5) of the step per step.
-const MIN_FACTOR: f64 = 0.1;
-const MAX_FACTOR: f64 = 5.0;
+const MIN_FACTOR: f64 = OPTIONS.min_factor;
+const MAX_FACTOR: f64 = OPTIONS.max_factor;
 /// 1/(q + 1) for the embedded estimate's order q = 4: the exponent of Gustafsson's
 /// predictive step (Hairer & Wanner, Solving ODEs II, IV.8, as in RADAU5).
 const PREDICTIVE_EXPONENT: f64 = 0.2;

@@ -70,7 +70,7 @@ pub struct Trial<const N: usize> {
 }
 
 /// y + h Σ a_j k_j over components 0..m; the others are y's.
-#[inline]
+#[inline(always)]
 fn combine<const N: usize>(y: &[f64; N], h: f64, terms: &[(f64, &[f64; N])], m: usize) -> [f64; N] {
     let mut out = *y;
     for i in 0..m {

@@ -12,12 +12,9 @@
 use serde::{Deserialize, Serialize};
 
 use super::Edge;
+use super::options::OPTIONS;
 
-/// Pieces remembered; a system with more pieces entered in turn forgets the oldest.
-const SLOTS: usize = 8;
-/// The remembered ratio stays within [1/100, 5] (5: the controller's largest growth).
-const MIN_RATIO: f64 = 0.01;
-const MAX_RATIO: f64 = 5.0;
+const SLOTS: usize = OPTIONS.entry_slots;
 
 /// A piece as the integrator sees it: its bounds, and the edge of the piece left behind.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -55,7 +52,9 @@ impl Entries {
     /// The controller, having judged the first step into `entry`, wants `wanted` where the
     /// base was `carried`.
     pub fn learn(&mut self, entry: &Entry, carried: f64, wanted: f64) {
-        let observed = (wanted / carried).clamp(MIN_RATIO, MAX_RATIO).ln();
+        let observed = (wanted / carried)
+            .clamp(OPTIONS.entry_ratio_min, OPTIONS.entry_ratio_max)
+            .ln();
         if !observed.is_finite() {
             return;
         }

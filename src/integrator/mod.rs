@@ -1,27 +1,28 @@
-//! Adaptive Runge-Kutta integration of piecewise-smooth ODEs, knowing nothing of gears.
+//! Integration of piecewise-smooth ODEs, knowing nothing of gears.
 //!
-//! - [`dopri5`]: the Dormand-Prince 5(4) pair with its 4th-order dense output (Hairer,
-//!   Nørsett & Wanner, *Solving ODEs I*, II.5), one step at a time.
-//! - [`control`]: the error norm (atol + rtol·|y| per component) and the step-size controller.
+//! - [`solver`]: the driver that reaches an exact end time piece by piece, ends steps exactly
+//!   on the edges of the system's pieces, and carries what it knows from one call to the next.
+//! - One stepper per kind of piece: `passage` for pieces with a solution in closed form (the
+//!   free flight), crossed without steps, their exit found by a root search that cannot step
+//!   over a crossing; [`taylor`] for pieces whose Taylor series the system gives;
+//!   `runge_kutta` for the others: [`dopri5`] (the Dormand-Prince 5(4) pair with its
+//!   4th-order dense output, Hairer, Nørsett & Wanner, *Solving ODEs I*, II.5) with the
+//!   controller of [`control`], or [`radau5`] (Radau IIA of order 5) while the problem is
+//!   stiff ([`stiffness`]), the first step into a piece learnt from earlier entries
+//!   (`entries`).
 //! - [`roots`]: the Illinois root finder used to locate edges on the dense output.
-//! - `entries`: the first step into a piece, from what was learnt of earlier entries.
-//! - `passage`: pieces with a solution in closed form (the free flight), crossed without
-//!   steps, their exit found by a root search that cannot step over a crossing.
-//! - [`radau5`]: the Radau IIA method of order 5 for stiff phases, one step at a time.
-//! - [`stiffness`]: when to hand over from one method to the other.
-//! - [`taylor`]: Taylor-series steps, where the system gives the series of its piece.
-//! - [`solver`]: the driver that reaches an exact end time, carries the step size and method
-//!   over from one call to the next, and ends steps exactly on the edges of the system's
-//!   pieces.
+//! - [`options`]: the tuned constants, each with its reason.
 
 pub mod control;
 pub mod dopri5;
 mod entries;
 mod left_off;
 pub mod linalg;
+pub mod options;
 mod passage;
 pub mod radau5;
 pub mod roots;
+mod runge_kutta;
 pub mod serde_array;
 pub mod solver;
 pub mod stiffness;
@@ -46,6 +47,27 @@ pub trait Dense<const N: usize> {
     fn ends(&self) -> (&[f64; N], &[f64; N]);
     /// Component i at t + θh, θ ∈ [0, 1].
     fn dense(&self, i: usize, theta: f64) -> f64;
+}
+
+/// A piece's solution in closed form from one start (t0, y0) ([`Piecewise::exact`]).
+pub trait ClosedForm<const N: usize> {
+    /// The state at t ≥ t0.
+    fn at(&self, t: f64) -> [f64; N];
+    /// A bound on |d² y[GUARD] / dt²| along the solution from t0 on, for as long as it stays
+    /// in the piece: what keeps the root search from stepping over a crossing.
+    fn guard_acceleration_bound(&self) -> f64;
+}
+
+/// The closed form of a system that has none.
+pub enum NoClosedForm {}
+
+impl<const N: usize> ClosedForm<N> for NoClosedForm {
+    fn at(&self, _: f64) -> [f64; N] {
+        match *self {}
+    }
+    fn guard_acceleration_bound(&self) -> f64 {
+        match *self {}
+    }
 }
 
 /// Which edge of the current piece a trajectory leaves through.
@@ -75,28 +97,13 @@ pub trait Piecewise<const N: usize>: System<N> {
         false
     }
 
-    /// Whether the current piece has a solution in closed form ([`Piecewise::exact`]): the
-    /// solver then takes no steps in it and finds where the solution leaves the piece by a
-    /// root search on it.
-    fn has_exact(&self) -> bool {
-        false
-    }
-
-    /// Called when a passage through the piece starts from (t0, y0): what the exact solution
-    /// from there shares between its points may be computed once here. [`Piecewise::exact`]
-    /// must give the same result whether or not this was called.
-    fn prepare_exact(&mut self, _t0: f64, _y0: &[f64; N]) {}
-
-    /// Where the piece has one: the state at t ≥ t0 from y0 at t0 in the current piece.
-    fn exact(&self, _t0: f64, y0: &[f64; N], _t: f64) -> [f64; N] {
-        *y0
-    }
-
-    /// With [`Piecewise::exact`]: a bound on |d² y[GUARD] / dt²| along the exact solution
-    /// from (t0, y0) on, for as long as it stays in the piece. It is what keeps the root
-    /// search from stepping over a crossing.
-    fn guard_acceleration_bound(&self, _t0: f64, _y0: &[f64; N]) -> f64 {
-        f64::INFINITY
+    /// Where the current piece has a solution in closed form (the free flight): that
+    /// solution from (t0, y0). The solver then takes no steps in the piece; it follows the
+    /// solution and finds where it leaves the piece by a root search on it (see `passage`).
+    /// The system may keep what the solution's points share, for the next call from the
+    /// same start. None (the default): the piece is crossed by steps.
+    fn exact(&mut self, _t0: f64, _y0: &[f64; N]) -> Option<impl ClosedForm<N>> {
+        None::<NoClosedForm>
     }
 
     /// Where the current piece's solution is analytic and the system can form its Taylor

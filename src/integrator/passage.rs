@@ -15,18 +15,16 @@
 use serde::{Deserialize, Serialize};
 
 use super::left_off::LeftOff;
-use super::{Edge, Piecewise};
-
-/// Largest number of evaluations of the exact solution in one call's search.
-const MAX_EVALS: u64 = 100_000;
+use super::options::OPTIONS;
+use super::{ClosedForm, Edge, Piecewise};
 
 /// A passage through a piece from (t0, y0), searched up to `t_clear`: no crossing in
 /// [t0, t_clear]; once `exit` is found, the piece is left through it at t_clear.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub(super) struct Passage<const N: usize> {
-    t0: f64,
+    pub t0: f64,
     #[serde(with = "super::serde_array")]
-    y0: [f64; N],
+    pub y0: [f64; N],
     /// Bound on |y[GUARD]''| from t0 on.
     bound: f64,
     pub t_clear: f64,
@@ -38,13 +36,12 @@ pub(super) struct Passage<const N: usize> {
 }
 
 impl<const N: usize> Passage<N> {
-    /// A passage starting at (t, y) in the system's current piece.
-    pub fn new<S: Piecewise<N>>(sys: &mut S, t: f64, y: &[f64; N]) -> Self {
-        sys.prepare_exact(t, y);
+    /// A passage starting at (t, y) along `exact`, the piece's solution from there.
+    pub fn new(t: f64, y: &[f64; N], exact: &impl ClosedForm<N>) -> Self {
         Passage {
             t0: t,
             y0: *y,
-            bound: sys.guard_acceleration_bound(t, y),
+            bound: exact.guard_acceleration_bound(),
             t_clear: t,
             y_clear: *y,
             exit: None,
@@ -57,11 +54,17 @@ impl<const N: usize> Passage<N> {
         self.left_off.continued_by(t, y)
     }
 
-    /// Extends the search until it is clear past t_end or has found the exit; returns the
-    /// number of evaluations of the exact solution, or None if it needed more than
-    /// `MAX_EVALS` (a guard creeping along a bound).
-    pub fn search<S: Piecewise<N>>(&mut self, sys: &S, t_end: f64, tol: f64) -> Option<u64> {
-        let (lo, hi) = sys.piece();
+    /// Extends the search along `exact` through the piece [lo, hi] of `S`'s guard until it
+    /// is clear past t_end or has found the exit; returns the number of evaluations of the
+    /// exact solution, or None if it needed more than `max_exit_evals` (a guard creeping
+    /// along a bound). The exit is declared within `tol` of a bound.
+    pub fn search<S: Piecewise<N>>(
+        &mut self,
+        exact: &impl ClosedForm<N>,
+        (lo, hi): (f64, f64),
+        t_end: f64,
+        tol: f64,
+    ) -> Option<u64> {
         let mut evals = 0;
         while self.exit.is_none() && self.t_clear < t_end {
             let (g, v) = (self.y_clear[S::GUARD], self.y_clear[S::RATE]);
@@ -83,36 +86,47 @@ impl<const N: usize> Passage<N> {
                     break;
                 }
                 evals += 1;
-                if evals > MAX_EVALS {
+                if evals > OPTIONS.max_exit_evals {
                     return None;
                 }
                 self.t_clear += s;
-                self.y_clear = sys.exact(self.t0, &self.y0, self.t_clear);
+                self.y_clear = exact.at(self.t_clear);
             }
         }
         Some(evals)
     }
 
     /// The state at t_end ≤ t_clear, handed out and remembered; returns the number of
-    /// evaluations of the exact solution it took (none at t_clear itself).
+    /// evaluations of the exact solution it took (none at t_clear itself), None if the
+    /// system's piece has no closed form.
     pub fn serve<S: Piecewise<N>>(
         &mut self,
-        sys: &S,
+        sys: &mut S,
         t: &mut f64,
         y: &mut [f64; N],
         t_end: f64,
-    ) -> u64 {
+    ) -> Option<u64> {
         let evals = if t_end == self.t_clear {
             *y = self.y_clear;
             0
         } else {
-            *y = sys.exact(self.t0, &self.y0, t_end);
+            *y = sys.exact(self.t0, &self.y0)?.at(t_end);
             1
         };
         *t = t_end;
         self.left_off = LeftOff::at(t_end, y);
-        evals
+        Some(evals)
     }
+}
+
+/// How close to an edge of the piece [lo, hi] the guard leaves through it: a share of its
+/// absolute tolerance `atol`, or a few rounding errors of the edges' values.
+pub(super) fn exit_tolerance((lo, hi): (f64, f64), atol: f64) -> f64 {
+    let scale = [lo, hi]
+        .iter()
+        .filter(|b| b.is_finite())
+        .fold(0.0f64, |m, b| m.max(b.abs()));
+    (OPTIONS.exit_share * atol).max(OPTIONS.min_step_ulps * f64::EPSILON * scale)
 }
 
 /// Time before a distance d ≥ 0 can be closed, starting at speed w towards it (negative:
@@ -150,31 +164,35 @@ mod tests {
         const GUARD: usize = 0;
         const RATE: usize = 1;
         fn piece(&self) -> (f64, f64) {
-            (0.0, 1.0)
+            PIECE
         }
         fn cross(&mut self, _: Edge, _: f64, _: &[f64; 2]) {}
-        fn has_exact(&self) -> bool {
-            true
-        }
-        fn exact(&self, _t0: f64, _y0: &[f64; 2], t: f64) -> [f64; 2] {
+    }
+
+    impl ClosedForm<2> for Swing {
+        fn at(&self, t: f64) -> [f64; 2] {
             let (a, w) = (self.a, self.omega);
             [
                 0.5 + a / (w * w) * ((w * t).cos() - 1.0),
                 -(a / w) * (w * t).sin(),
             ]
         }
-        fn guard_acceleration_bound(&self, _t0: f64, _y0: &[f64; 2]) -> f64 {
+        fn guard_acceleration_bound(&self) -> f64 {
             self.a
         }
     }
+
+    const PIECE: (f64, f64) = (0.0, 1.0);
 
     /// A transversal crossing is found where it is, to the tolerance, in a few evaluations.
     #[test]
     fn finds_a_crossing() {
         // g = 0 first where cos ωt = 1 − ω²/(2a): a = 4, ω = 2 → cos 2t = 0.5, t = π/6.
-        let mut sys = Swing { a: 4.0, omega: 2.0 };
-        let mut p = Passage::new(&mut sys, 0.0, &[0.5, 0.0]);
-        let evals = p.search(&sys, 10.0, 1e-12).expect("found");
+        let swing = Swing { a: 4.0, omega: 2.0 };
+        let mut p = Passage::new(0.0, &[0.5, 0.0], &swing);
+        let evals = p
+            .search::<Swing>(&swing, PIECE, 10.0, 1e-12)
+            .expect("found");
         assert_eq!(p.exit, Some(Edge::Lower));
         let t_exact = std::f64::consts::PI / 6.0;
         assert!(
@@ -191,21 +209,23 @@ mod tests {
     #[test]
     fn neither_invents_nor_skips_a_grazing_crossing() {
         // min g = 0.5 − 2a/ω² (at ωt = π).
-        let mut near = Swing {
+        let near = Swing {
             a: (0.5 - 1e-9) / 2.0 * 4.0,
             omega: 2.0,
         };
-        let mut p = Passage::new(&mut near, 0.0, &[0.5, 0.0]);
-        p.search(&near, 3.0, 1e-12).expect("searched");
+        let mut p = Passage::new(0.0, &[0.5, 0.0], &near);
+        p.search::<Swing>(&near, PIECE, 3.0, 1e-12)
+            .expect("searched");
         assert_eq!(p.exit, None, "no crossing: the swing turns back 1e-9 short");
         assert!(p.t_clear >= 3.0);
 
-        let mut dip = Swing {
+        let dip = Swing {
             a: (0.5 + 1e-8) / 2.0 * 4.0,
             omega: 2.0,
         };
-        let mut p = Passage::new(&mut dip, 0.0, &[0.5, 0.0]);
-        p.search(&dip, 3.0, 1e-12).expect("searched");
+        let mut p = Passage::new(0.0, &[0.5, 0.0], &dip);
+        p.search::<Swing>(&dip, PIECE, 3.0, 1e-12)
+            .expect("searched");
         assert_eq!(p.exit, Some(Edge::Lower));
         // It crosses just before ωt = π, i.e. t = π/2.
         assert!(

@@ -312,10 +312,6 @@ impl<const N: usize> Stepper<N> {
         stepper
     }
 
-    pub fn tolerance(&self) -> &Tolerance<N> {
-        &self.tol
-    }
-
     /// RADAU5's transformation: rtol' = 0.1 rtol^(2/3), atol' = atol · rtol'/rtol; the Newton
     /// iteration stops at max(10 ε/rtol', min(0.03, √rtol')) in the weighted norm.
     pub fn set_tolerance(&mut self, tol: Tolerance<N>) {

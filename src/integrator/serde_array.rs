@@ -1,6 +1,6 @@
 //! serde for `[f64; N]` with a const-generic N (serde's own impls cover fixed sizes only),
 //! used as `#[serde(with = "serde_array")]` on the solver's arrays, and for `[[f64; N]; M]`
-//! (`serde_array::rows`).
+//! (`serde_array::rows`) and `Option<[f64; N]>` (`serde_array::option`).
 
 use serde::de::{Error, SeqAccess, Visitor};
 use serde::ser::SerializeTuple;
@@ -63,5 +63,28 @@ pub mod rows {
             a[k / N][k % N] = x;
         }
         Ok(a)
+    }
+}
+
+/// serde for `Option<[f64; N]>`, as an optional list of N numbers.
+pub mod option {
+    use serde::de::Error;
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+    pub fn serialize<S: Serializer, const N: usize>(
+        a: &Option<[f64; N]>,
+        s: S,
+    ) -> Result<S::Ok, S::Error> {
+        a.map(|a| a.to_vec()).serialize(s)
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>, const N: usize>(
+        d: D,
+    ) -> Result<Option<[f64; N]>, D::Error> {
+        Option::<Vec<f64>>::deserialize(d)?
+            .map(|v| {
+                <[f64; N]>::try_from(v).map_err(|v| D::Error::invalid_length(v.len(), &"N numbers"))
+            })
+            .transpose()
     }
 }

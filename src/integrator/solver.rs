@@ -1,31 +1,29 @@
-//! The driver: advances a piecewise-smooth system to an exact end time with adaptive steps,
-//! ends steps exactly on the edges of the pieces (so no step straddles a kink), and keeps its
-//! step size, method and controllers' memory from one call to the next.
+//! The driver: advances a piecewise-smooth system to an exact end time, piece by piece, each
+//! crossed the way the system says it can be: in closed form ([`Piecewise::exact`], no steps:
+//! `passage`), by Taylor-series steps ([`Piecewise::series`]: `taylor`) or by Runge-Kutta
+//! steps (`runge_kutta`). Whichever stepper took a step, the driver ends it in one place: on
+//! the edge inside it (crossed there, so no step straddles a kink), or on the end time, or
+//! kept past the end time. The limits of a call are checked in one place too ([`Budget`]).
 //!
 //! With `interpolate_ends`, explicit steps run past the end times and serve them from their
 //! dense output, so that the trajectory and its cost do not depend on how often the caller
-//! asks (communication steps of 10 µs take the steps of 10 ms ones, bit for bit).
-//!
-//! A piece with a solution in closed form ([`Piecewise::has_exact`]) is crossed without
-//! steps: `passage` searches where that solution leaves the piece, and serves the end times
-//! inside it from the solution itself.
-//!
-//! The method is DOPRI5, with Taylor-series steps in the pieces whose series the system gives
-//! ([`Piecewise::series`], `series_step`), or Radau IIA while the problem is stiff
-//! ([`Method::Auto`], the rule in `stiffness`), or either one throughout. Edges are located the same way on both methods'
-//! dense outputs. A non-stiff run pays for the implicit side only Hairer's stiffness
-//! estimate per accepted step (two weighted norms of the stages DOPRI5 has computed anyway).
+//! asks (communication steps of 10 µs take the steps of 10 ms ones, bit for bit). A passage
+//! in closed form serves the end times inside it from the solution itself. Both are kept from
+//! one call to the next while the caller continues from where the last call left off.
 
-use super::control::{Controller, Tolerance};
-use super::dopri5::{self, EVALS_PER_STEP};
-use super::entries::{Entries, Entry};
+use super::control::Tolerance;
+use super::dopri5;
+use super::entries::Entry;
 use super::left_off::LeftOff;
-use super::passage::Passage;
-use super::radau5::{Jacobian, RadauTrial, Stepper};
+use super::options::OPTIONS;
+use super::passage::{self, Passage};
+use super::radau5::Jacobian;
 use super::roots::illinois;
-use super::stiffness::{Switch, spectral_radius, stiffness};
+use super::runge_kutta::{Accepted, Mode, RungeKutta};
 use super::{Dense, Edge, Piecewise, taylor};
 use serde::{Deserialize, Serialize};
+
+pub use super::runge_kutta::Method;
 
 /// Work counters.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -90,44 +88,82 @@ impl std::fmt::Display for SolverError {
     }
 }
 
-/// The first DOPRI5 step into a piece that is rough at its start ([`Piecewise::rough_start`])
-/// is accepted at 1/20 of the tolerance. Where a force law starts at the edge as a
-/// non-integer power (contact without a smoothing band, F ∝ δ^α), the solution is not smooth
-/// at the step's start and DOPRI5's embedded estimate understates that step's error (6 to 20
-/// times for x'' = −τ^α, α in (1, 2)). The steps after the first start inside the piece,
-/// where the estimate holds again; applied at every crossing the factor only moves errors
-/// around (docs/DECISIONS.md, D6).
-const FIRST_STEP_DISTRUST: f64 = 20.0;
-
-/// Edge crossings allowed at one instant before the solver gives up.
-const MAX_CROSSINGS_AT_ONCE: u32 = 8;
-
-/// Which method steps (the FMU's `solver` parameter).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-pub enum Method {
-    /// DOPRI5, handing over to Radau IIA while the problem is stiff.
-    #[default]
-    Auto,
-    /// DOPRI5 throughout.
-    Explicit,
-    /// Radau IIA throughout.
-    Implicit,
+/// The limits of one call of [`Solver::advance`]: steps taken, and edges crossed at the same
+/// instant.
+#[derive(Default)]
+pub(super) struct Budget {
+    steps: u64,
+    crossings_here: u32,
 }
 
-/// An accepted step, whichever method took it.
-struct Accepted<const N: usize> {
-    y1: [f64; N],
-    /// Taken by DOPRI5: the trial buffer holds the step (its last stage is f(t + h, y1); its
-    /// dense output serves the points inside it). False for Radau IIA.
-    explicit: bool,
-    h_next: f64,
-    /// The edge the step leaves its piece through, and at which fraction of the step.
-    edge: Option<(Edge, f64)>,
-    /// DOPRI5's stiffness estimate h·ρ of the step (0 when not asked for).
-    h_rho: f64,
+impl Budget {
+    /// The next step from t towards t_end, `natural` long (infinite: unbounded): its size
+    /// and whether it is cut to end on t_end (not when it may step `past` it). It ends on
+    /// t_end, not a sliver before (Hairer's 1.01). Fails when the step is below the
+    /// resolution of time or the call has taken too many.
+    pub fn step(
+        &mut self,
+        t: f64,
+        t_end: f64,
+        natural: f64,
+        past: bool,
+    ) -> Result<(f64, bool), SolverError> {
+        let last = !natural.is_finite() || (!past && t + OPTIONS.sliver * natural >= t_end);
+        let h = if last { t_end - t } else { natural };
+        if h <= OPTIONS.min_step_ulps * f64::EPSILON * t.abs().max(t_end.abs()) {
+            return Err(SolverError::StepTooSmall { t, h });
+        }
+        self.steps += 1;
+        if self.steps > OPTIONS.max_steps {
+            return Err(SolverError::TooManySteps {
+                t,
+                steps: OPTIONS.max_steps,
+            });
+        }
+        Ok((h, last))
+    }
+
+    /// An edge crossed at θ of a step from t: with progress in time, or again at the same
+    /// instant, which fails after a few times.
+    fn crossing(&mut self, t: f64, theta: f64) -> Result<(), SolverError> {
+        if theta > 0.0 {
+            self.crossings_here = 0;
+        } else {
+            self.crossings_here += 1;
+            if self.crossings_here > OPTIONS.crossings_at_once {
+                return Err(SolverError::Chattering { t });
+            }
+        }
+        Ok(())
+    }
 }
 
-/// A DOPRI5 step taken past the end time of a call ([`Solver::interpolate_ends`]): the end
+/// An accepted step, whichever stepper took it.
+enum Taken<'a, const N: usize> {
+    /// A Taylor step, its polynomial its own dense output; cut to end on t_end if `last`.
+    Series(&'a taylor::Step<N>, bool),
+    /// A DOPRI5 step (in the trial buffer) or a Radau IIA step.
+    RungeKutta(Accepted<N>),
+}
+
+/// What a call keeps for the next one, to serve end times from if it continues from where
+/// this one left off.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+enum Kept<const N: usize> {
+    /// An explicit step taken past the end time (`interpolate_ends`).
+    Step(Ahead<N>),
+    /// The passage through a piece in closed form.
+    Passage(Passage<N>),
+}
+
+/// Whether a call goes on stepping or has reached its end time.
+#[derive(PartialEq)]
+enum Flow {
+    Go,
+    Done,
+}
+
+/// An explicit step taken past the end time of a call ([`Solver::interpolate_ends`]): the end
 /// times inside it come from its dense output, and stepping resumes from its end.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 struct Ahead<const N: usize> {
@@ -147,10 +183,6 @@ impl<const N: usize> Ahead<N> {
     /// Where the kept step ends.
     fn t1(&self) -> f64 {
         self.t0 + self.h
-    }
-
-    fn continued_by(&self, t: f64, y: &[f64; N]) -> bool {
-        self.left_off.continued_by(t, y)
     }
 
     /// (t, y) at t_end inside the step, handed out and remembered.
@@ -178,52 +210,23 @@ impl<const N: usize> Interpolant<N> {
     }
 }
 
-/// Where a step starts: t, y and f(t, y).
-#[derive(Clone, Copy)]
-struct Start<'a, const N: usize> {
-    t: f64,
-    y: &'a [f64; N],
-    k1: &'a [f64; N],
-}
-
-/// Adaptive DOPRI5 / Radau IIA with edge location; all of its state is plain data (copyable).
+/// The driver over a piecewise system's pieces, with edge location; all of its state is
+/// plain data (copyable, part of the FMU state).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Solver<const N: usize> {
     tol: Tolerance<N>,
-    /// Most steps one `advance` may take.
-    pub max_steps: u64,
-    /// End times of `advance` are reached by interpolation inside DOPRI5's natural steps
-    /// (4th-order dense output) instead of by steps cut short to end on them: the
-    /// trajectory, and its cost, are then those of a run without those end times, however
+    /// End times of `advance` are reached by interpolation inside the explicit steps'
+    /// natural lengths (their dense output) instead of by steps cut short to end on them:
+    /// the trajectory, and its cost, are then those of a run without those end times, however
     /// close together they are. For systems that do not change between calls (the bench's
     /// sine); a caller that changes the system must call `invalidate`.
     pub interpolate_ends: bool,
     pub stats: Stats,
-    method: Method,
-    /// Radau IIA is stepping now.
-    implicit: bool,
-    /// Step size proposed for the next step (0: not chosen yet).
-    h: f64,
-    controller: Controller,
-    stepper: Stepper<N>,
-    switch: Switch,
-    /// Spectral radius of Radau's latest Jacobian, and that Jacobian's number.
-    rho: f64,
-    rho_of: u64,
-    /// f(t, y) at the current point (first stage of the next step), when `k1_valid`.
-    #[serde(with = "super::serde_array")]
-    k1: [f64; N],
-    k1_valid: bool,
+    rk: RungeKutta<N>,
     /// An edge was just crossed: the state may lie a rounding error short of it, on the side
     /// of the piece it left, and must not be sent back there.
     just_crossed: bool,
-    ahead: Option<Ahead<N>>,
-    /// The passage through a piece with an exact solution, kept from the last call.
-    passage: Option<Passage<N>>,
-    /// The piece just entered, until its first DOPRI5 step is judged, and what was learnt
-    /// of the first steps into each piece (see `entries`).
-    entering: Option<Entry>,
-    entries: Entries,
+    kept: Option<Kept<N>>,
 }
 
 impl<const N: usize> Solver<N> {
@@ -235,44 +238,30 @@ impl<const N: usize> Solver<N> {
     pub fn with_method(tol: Tolerance<N>, method: Method) -> Self {
         Solver {
             tol,
-            max_steps: 10_000_000,
             interpolate_ends: false,
             stats: Stats::default(),
-            method,
-            implicit: method == Method::Implicit,
-            h: 0.0,
-            controller: Controller::default(),
-            stepper: Stepper::new(tol),
-            switch: Switch::default(),
-            rho: 0.0,
-            rho_of: 0,
-            k1: [0.0; N],
-            k1_valid: false,
+            rk: RungeKutta::new(tol, method),
             just_crossed: false,
-            ahead: None,
-            passage: None,
-            entering: None,
-            entries: Entries::default(),
+            kept: None,
         }
-    }
-
-    pub fn tolerance(&self) -> &Tolerance<N> {
-        &self.tol
     }
 
     /// True while Radau IIA steps.
     pub fn is_implicit(&self) -> bool {
-        self.implicit
+        self.rk.mode == Mode::Radau
+    }
+
+    /// Step size the next step will try.
+    pub fn proposed_step(&self) -> f64 {
+        self.rk.h
     }
 
     /// To be called when the system or the state changed from outside (new inputs, a jump):
     /// the stored derivative, Jacobian and extrapolations no longer hold.
     pub fn invalidate(&mut self) {
-        self.k1_valid = false;
+        self.rk.invalidate();
         self.just_crossed = false;
-        self.ahead = None;
-        self.passage = None;
-        self.stepper.invalidate();
+        self.kept = None;
     }
 
     /// Moves (t, y) to t_end inside the step or the passage kept from the last call, if that
@@ -280,40 +269,25 @@ impl<const N: usize> Solver<N> {
     /// cannot fail. False, with nothing changed, otherwise.
     pub fn serve<S: Piecewise<N>>(
         &mut self,
-        sys: &S,
+        sys: &mut S,
         t: &mut f64,
         y: &mut [f64; N],
         t_end: f64,
     ) -> bool {
-        if let Some(a) = &mut self.ahead
-            && a.continued_by(*t, y)
-            && t_end <= a.t1()
-        {
-            a.serve(t, y, t_end);
-            return true;
+        match &mut self.kept {
+            Some(Kept::Step(a)) if a.left_off.continued_by(*t, y) && t_end <= a.t1() => {
+                a.serve(t, y, t_end);
+                true
+            }
+            Some(Kept::Passage(p)) if p.continued_by(*t, y) && t_end <= p.t_clear => {
+                let Some(evals) = p.serve(sys, t, y, t_end) else {
+                    return false;
+                };
+                self.stats.exact_evals += evals;
+                true
+            }
+            _ => false,
         }
-        if let Some(p) = &mut self.passage
-            && p.continued_by(*t, y)
-            && t_end <= p.t_clear
-        {
-            self.stats.exact_evals += p.serve(sys, t, y, t_end);
-            return true;
-        }
-        false
-    }
-
-    /// Step size the next step will try.
-    pub fn proposed_step(&self) -> f64 {
-        self.h
-    }
-
-    fn derivative<S: Piecewise<N>>(&mut self, sys: &S, t: f64, y: &[f64; N]) -> [f64; N] {
-        if !self.k1_valid {
-            self.stats.rhs_evals += 1;
-            self.k1 = sys.rhs(t, y);
-            self.k1_valid = true;
-        }
-        self.k1
     }
 
     /// Advances (t, y) to `t_end` exactly.
@@ -327,20 +301,8 @@ impl<const N: usize> Solver<N> {
         if self.serve(sys, t, y, t_end) {
             return Ok(());
         }
-        if let Some(ahead) = self.ahead.take() {
-            if !ahead.continued_by(*t, y) {
-                // Not where the last call left off: k1 was f at the step's end.
-                self.k1_valid = false;
-            } else {
-                *t = ahead.t1();
-                *y = ahead.y1;
-                if let Some(edge) = ahead.edge {
-                    self.cross(sys, edge, *t, y);
-                }
-            }
-        }
-        let mut steps = 0u64;
-        let mut crossings_here = 0u32;
+        self.resume(sys, t, y);
+        let mut budget = Budget::default();
         // The DOPRI5 steps are written here in place (see `dopri5::step`), the series too.
         let mut trial = dopri5::Trial::empty();
         let mut series = [[0.0; N]; taylor::TERMS];
@@ -348,252 +310,192 @@ impl<const N: usize> Solver<N> {
             if !self.just_crossed && sys.settle(*t, y) > 0 {
                 self.invalidate();
             }
-            if sys.has_exact() {
-                if self.pass(sys, t, y, t_end)? {
-                    continue;
+            if let Some(flow) = self.pass(sys, t, y, t_end)? {
+                match flow {
+                    Flow::Go => continue,
+                    Flow::Done => return Ok(()),
                 }
-                return Ok(());
             }
-            if !self.implicit && sys.series(*t, y, &mut series) {
-                steps += 1;
-                if steps > self.max_steps {
-                    return Err(SolverError::TooManySteps {
-                        t: *t,
-                        steps: self.max_steps,
-                    });
-                }
-                if self.series_step(sys, &series, t, y, t_end, &mut crossings_here)? {
-                    continue;
-                }
-                return Ok(());
-            }
-            let k1 = self.derivative(sys, *t, y);
-            if self.h <= 0.0 {
-                // Capped by the call's length only where steps end on t_end: with
-                // `interpolate_ends` the first step must not depend on the end time asked
-                // for, or neither would the trajectory.
-                let h_max = if self.interpolate_ends && !self.implicit {
-                    f64::INFINITY
-                } else {
-                    t_end - *t
-                };
-                self.h = self.initial_step(sys, *t, y, &k1, h_max);
-            }
-            // The first DOPRI5 step into a piece just entered starts from what was learnt of
-            // that piece's entries, as a ratio to a base: the time to cross the piece at the
-            // guard's rate where the piece is bounded (a band: ε/|ξ'|, whatever step the
-            // free flight or the contact before it left), else the step carried over the edge.
-            let entering = match self.entering.take() {
-                Some(entry) if !self.implicit => {
-                    let rate = y[S::RATE].abs();
-                    let width = entry.hi - entry.lo;
-                    let base = if width.is_finite() && rate > 0.0 {
-                        width / rate
-                    } else {
-                        self.h
-                    };
-                    self.h = base * self.entries.ratio(&entry);
-                    Some((entry, base))
-                }
-                _ => None,
-            };
-            // Reach t_end exactly, without leaving a sliver (Hairer's 1.01), or step past it.
-            let step_past = self.interpolate_ends && !self.implicit;
-            let last = !step_past && *t + 1.01 * self.h >= t_end;
-            let h = if last { t_end - *t } else { self.h };
-            if h <= 16.0 * f64::EPSILON * t.abs().max(t_end.abs()) {
-                return Err(SolverError::StepTooSmall { t: *t, h });
-            }
-            steps += 1;
-            if steps > self.max_steps {
-                return Err(SolverError::TooManySteps {
-                    t: *t,
-                    steps: self.max_steps,
-                });
-            }
-            let start = Start { t: *t, y, k1: &k1 };
-            let attempt = self.attempt(sys, start, h, &mut trial);
-            if let Some((entry, carried)) = entering {
-                let wanted = attempt.as_ref().map_or_else(|h_next| *h_next, |s| s.h_next);
-                self.entries.learn(&entry, carried, wanted);
-            }
-            let step = match attempt {
-                Ok(step) => step,
-                Err(h_next) => {
-                    self.stats.rejected += 1;
-                    self.h = h_next;
-                    continue;
-                }
-            };
-            self.stats.accepted += 1;
-            if self.implicit {
-                self.stats.implicit_steps += 1;
-            }
-            if let Some((edge, theta)) = step.edge
-                && step_past
-                && *t + theta * h > t_end
-            {
-                // The edge lies past t_end: the step redone to end on it is kept ahead, t_end
-                // served from it, and the edge crossed when a call goes past it.
-                self.explicit_step(sys, start, theta * h, &mut trial);
-                self.h = step.h_next.max(theta * h);
-                self.keep_ahead(&trial, Some(edge), t, y, t_end);
-                return Ok(());
-            }
-            if let Some((edge, theta)) = step.edge {
-                // Redo the step so that it ends on the edge, then cross it. The state is kept
-                // as the step gives it (not moved onto the edge: where the force is not zero
-                // there, that would add or remove energy at every crossing).
-                if theta > 0.0 {
-                    let Some(y_edge) = self.redo(sys, start, theta * h, &mut trial) else {
-                        self.h = 0.5 * theta * h;
-                        continue;
-                    };
-                    *y = y_edge;
-                    *t += theta * h;
-                    crossings_here = 0;
-                } else {
-                    crossings_here += 1;
-                    if crossings_here > MAX_CROSSINGS_AT_ONCE {
-                        return Err(SolverError::Chattering { t: *t });
-                    }
-                }
-                self.cross(sys, edge, *t, y);
-                self.h = step.h_next.max(theta * h);
-                continue;
-            }
-            crossings_here = 0;
-            self.just_crossed = false;
-            if step.explicit {
-                self.k1 = *trial.k_end();
+            let past = self.interpolate_ends && self.rk.mode == Mode::Dopri5;
+            let series_step;
+            let step = if self.rk.mode == Mode::Dopri5 && sys.series(*t, y, &mut series) {
+                let natural = taylor::Step::length(&series, &self.tol);
+                let (h, last) = budget.step(*t, t_end, natural, past)?;
+                series_step = taylor::Step::new(series, h);
+                sys.observe(*t, h, &series_step);
+                self.stats.accepted += 1;
+                self.stats.series_steps += 1;
+                self.rk.stepped_by_series();
+                Taken::Series(&series_step, last)
             } else {
-                self.k1_valid = false;
-            }
-            if step.explicit && step_past && *t + h > t_end {
-                self.h = step.h_next;
-                self.hand_over(step.h_rho);
-                self.keep_ahead(&trial, None, t, y, t_end);
+                let rough = self.just_crossed && sys.rough_start();
+                let work = (&self.tol, &mut self.stats, &mut budget);
+                match self
+                    .rk
+                    .attempt(sys, work, (*t, y), t_end, past, rough, &mut trial)?
+                {
+                    Some(accepted) => Taken::RungeKutta(accepted),
+                    None => continue,
+                }
+            };
+            let flow = self.end_step(sys, &step, (t, y), t_end, past, &mut budget, &mut trial)?;
+            if flow == Flow::Done {
                 return Ok(());
             }
-            *t = if last { t_end } else { *t + h };
-            *y = step.y1;
-            // A step cut short to land on t_end says little about the natural step size.
-            self.h = if last {
-                step.h_next.max(self.h)
-            } else {
-                step.h_next
-            };
-            self.hand_over(step.h_rho);
         }
         Ok(())
     }
 
-    /// Through a piece with an exact solution (see `passage`): to t_end, or to where the
-    /// solution leaves the piece, crossing that edge (true). The passage is kept for the next
-    /// call while it continues.
+    /// At the start of a call: from the end of the step kept by the last one if the call
+    /// continues from where that left off (crossing the edge it ends on), else without it.
+    fn resume<S: Piecewise<N>>(&mut self, sys: &mut S, t: &mut f64, y: &mut [f64; N]) {
+        let Some(Kept::Step(ahead)) = &self.kept else {
+            return;
+        };
+        let (continued, t1, y1, edge) = (
+            ahead.left_off.continued_by(*t, y),
+            ahead.t1(),
+            ahead.y1,
+            ahead.edge,
+        );
+        self.kept = None;
+        if !continued {
+            // f is known at the kept step's end, not here.
+            self.rk.moved();
+            return;
+        }
+        (*t, *y) = (t1, y1);
+        if let Some(edge) = edge {
+            self.cross(sys, edge, *t, y);
+        }
+    }
+
+    /// Through a piece in closed form (see `passage`): to t_end, where the passage is kept
+    /// for the next call (Done), or to where the solution leaves the piece, crossing that
+    /// edge (Go). None if the piece has no closed form.
     fn pass<S: Piecewise<N>>(
         &mut self,
         sys: &mut S,
         t: &mut f64,
         y: &mut [f64; N],
         t_end: f64,
-    ) -> Result<bool, SolverError> {
-        let mut passage = match self.passage.take() {
-            Some(p) if p.continued_by(*t, y) => p,
-            _ => Passage::new(sys, *t, y),
+    ) -> Result<Option<Flow>, SolverError> {
+        let continued = match self.kept {
+            Some(Kept::Passage(p)) if p.continued_by(*t, y) => Some(p),
+            _ => None,
         };
-        // Close enough to an edge to cross it: a thousandth of the guard's absolute
-        // tolerance, or a few rounding errors of the edges.
-        let (lo, hi) = sys.piece();
-        let scale = [lo, hi]
-            .iter()
-            .filter(|b| b.is_finite())
-            .fold(0.0f64, |m, b| m.max(b.abs()));
-        let tol = (1e-3 * self.tol.atol[S::GUARD]).max(16.0 * f64::EPSILON * scale);
+        let (t0, y0) = continued.map_or((*t, *y), |p| (p.t0, p.y0));
+        let piece = sys.piece();
+        let Some(exact) = sys.exact(t0, &y0) else {
+            return Ok(None);
+        };
+        let mut passage = continued.unwrap_or_else(|| Passage::new(t0, &y0, &exact));
+        self.kept = None;
+        let tol = passage::exit_tolerance(piece, self.tol.atol[S::GUARD]);
         let evals = passage
-            .search(sys, t_end, tol)
+            .search::<S>(&exact, piece, t_end, tol)
             .ok_or(SolverError::SearchStalled { t: *t })?;
         self.stats.exact_evals += evals;
+        drop(exact);
         match passage.exit {
             Some(edge) if passage.t_clear <= t_end => {
                 *t = passage.t_clear;
                 *y = passage.y_clear;
                 self.cross(sys, edge, *t, y);
-                Ok(true)
+                Ok(Some(Flow::Go))
             }
             _ => {
-                self.stats.exact_evals += passage.serve(sys, t, y, t_end);
-                self.passage = Some(passage);
-                Ok(false)
+                self.stats.exact_evals += passage.serve(sys, t, y, t_end).unwrap_or(0);
+                self.kept = Some(Kept::Passage(passage));
+                Ok(Some(Flow::Done))
             }
         }
     }
 
-    /// A Taylor step from (t, y) with the series `c` of the current piece: as long as the
-    /// tolerance allows, or to t_end, or to an edge inside it, which is then crossed. False
-    /// when the step reaches past t_end and is kept for the next call (`interpolate_ends`),
-    /// t_end served from it.
-    fn series_step<S: Piecewise<N>>(
+    /// Ends an accepted step from (t, y): on the edge it leaves its piece through, which is
+    /// then crossed; else at its end, or on t_end if it was cut short to; else, reaching past
+    /// t_end, kept for the next call with t_end served from it (ending on the edge past
+    /// t_end, if any, crossed when a call goes past it).
+    ///
+    /// An edge is reached by redoing the Runge-Kutta step to end on it, and on the Taylor
+    /// step's own polynomial. The state is kept as the step gives it (not moved onto the
+    /// edge: where the force is not zero there, that would add or remove energy at every
+    /// crossing).
+    #[allow(clippy::too_many_arguments)]
+    fn end_step<S: Piecewise<N> + Jacobian<N>>(
         &mut self,
         sys: &mut S,
-        c: &taylor::Coefficients<N>,
-        t: &mut f64,
-        y: &mut [f64; N],
+        step: &Taken<N>,
+        (t, y): (&mut f64, &mut [f64; N]),
         t_end: f64,
-        crossings_here: &mut u32,
-    ) -> Result<bool, SolverError> {
-        let step_past = self.interpolate_ends;
-        let natural = taylor::Step::length(c, &self.tol);
-        let last = !natural.is_finite() || (!step_past && *t + 1.01 * natural >= t_end);
-        let h = if last { t_end - *t } else { natural };
-        if h <= 16.0 * f64::EPSILON * t.abs().max(t_end.abs()) {
-            return Err(SolverError::StepTooSmall { t: *t, h });
-        }
-        let step = taylor::Step::new(*c, h);
-        sys.observe(*t, h, &step);
-        self.stats.accepted += 1;
-        self.stats.series_steps += 1;
-        // What DOPRI5 knew of this point and of the piece's entry does not carry over.
-        self.k1_valid = false;
-        self.entering = None;
-        let (lo, hi) = sys.piece();
-        if let Some((edge, theta)) = locate_edge(&step, (S::GUARD, S::RATE), lo, hi) {
-            if step_past && *t + theta * h > t_end {
-                // The edge lies past t_end: the step up to it is kept, as DOPRI5's is.
-                let kept = taylor::Step::new(*c, theta * h);
-                self.keep(
-                    Interpolant::Taylor(kept),
-                    kept.h,
-                    kept.y1,
-                    Some(edge),
-                    t,
-                    y,
-                    t_end,
-                );
-                return Ok(false);
+        past: bool,
+        budget: &mut Budget,
+        trial: &mut dopri5::Trial<N>,
+    ) -> Result<Flow, SolverError> {
+        let (h, y1, edge) = match step {
+            Taken::Series(s, _) => {
+                let (lo, hi) = sys.piece();
+                (s.h, s.y1, locate_edge(*s, (S::GUARD, S::RATE), lo, hi))
+            }
+            Taken::RungeKutta(a) => (a.h, a.y1, a.edge),
+        };
+        let work = (&self.tol, &mut self.stats);
+        if let Some((edge, theta)) = edge {
+            if past && *t + theta * h > t_end {
+                let (dense, h_kept, y_kept) = match step {
+                    Taken::Series(s, _) => {
+                        let kept = s.cut(theta);
+                        (Interpolant::Taylor(kept), kept.h, kept.y1)
+                    }
+                    Taken::RungeKutta(a) => {
+                        // Stepping past t_end, the step is DOPRI5's.
+                        self.rk.redo(sys, work, (*t, y), a, theta, trial);
+                        self.rk.ended_on_edge(a, theta);
+                        (Interpolant::Dopri5(trial.continuous()), trial.h, trial.y1)
+                    }
+                };
+                self.keep(dense, h_kept, y_kept, Some(edge), (t, y), t_end);
+                return Ok(Flow::Done);
             }
             if theta > 0.0 {
-                *y = step.at(theta);
+                *y = match step {
+                    Taken::Series(s, _) => s.at(theta),
+                    Taken::RungeKutta(a) => {
+                        match self.rk.redo(sys, work, (*t, y), a, theta, trial) {
+                            Some(y_edge) => y_edge,
+                            None => return Ok(Flow::Go),
+                        }
+                    }
+                };
                 *t += theta * h;
-                *crossings_here = 0;
-            } else {
-                *crossings_here += 1;
-                if *crossings_here > MAX_CROSSINGS_AT_ONCE {
-                    return Err(SolverError::Chattering { t: *t });
-                }
             }
+            budget.crossing(*t, theta)?;
             self.cross(sys, edge, *t, y);
-            return Ok(true);
+            if let Taken::RungeKutta(a) = step {
+                self.rk.ended_on_edge(a, theta);
+            }
+            return Ok(Flow::Go);
         }
-        *crossings_here = 0;
+        budget.crossings_here = 0;
         self.just_crossed = false;
-        if step_past && *t + h > t_end {
-            self.keep(Interpolant::Taylor(step), h, step.y1, None, t, y, t_end);
-            return Ok(false);
+        let last = match step {
+            Taken::Series(_, last) => *last,
+            Taken::RungeKutta(a) => {
+                self.rk.ended_inside(a, trial, &mut self.stats);
+                a.last
+            }
+        };
+        if past && *t + h > t_end {
+            let dense = match step {
+                Taken::Series(s, _) => Interpolant::Taylor(**s),
+                Taken::RungeKutta(_) => Interpolant::Dopri5(trial.continuous()),
+            };
+            self.keep(dense, h, y1, None, (t, y), t_end);
+            return Ok(Flow::Done);
         }
         *t = if last { t_end } else { *t + h };
-        *y = step.y1;
-        Ok(true)
+        *y = y1;
+        Ok(Flow::Go)
     }
 
     /// Crosses `edge` at (t, y): the system changes piece, and what was known of the old one
@@ -601,42 +503,24 @@ impl<const N: usize> Solver<N> {
     fn cross<S: Piecewise<N>>(&mut self, sys: &mut S, edge: Edge, t: f64, y: &[f64; N]) {
         sys.cross(edge, t, y);
         let (lo, hi) = sys.piece();
-        self.entering = Some(Entry {
+        self.rk.entered(Entry {
             lo,
             hi,
             through: edge,
         });
         self.stats.edges += 1;
-        self.k1_valid = false;
-        self.stepper.invalidate();
         self.just_crossed = true;
     }
 
-    /// Keeps an accepted DOPRI5 step from (t, y) that reaches past t_end (ending on `edge`,
+    /// Keeps a step from (t, y) of length h to y1 that reaches past t_end (ending on `edge`,
     /// if any) and hands out (t_end, y(t_end)) from its dense output.
-    fn keep_ahead(
-        &mut self,
-        step: &dopri5::Trial<N>,
-        edge: Option<Edge>,
-        t: &mut f64,
-        y: &mut [f64; N],
-        t_end: f64,
-    ) {
-        let dense = Interpolant::Dopri5(step.continuous());
-        self.keep(dense, step.h, step.y1, edge, t, y, t_end);
-    }
-
-    /// Keeps a step from (t, y) of length h to y1 that reaches past t_end and hands out
-    /// (t_end, y(t_end)) from its dense output.
-    #[allow(clippy::too_many_arguments)]
     fn keep(
         &mut self,
         dense: Interpolant<N>,
         h: f64,
         y1: [f64; N],
         edge: Option<Edge>,
-        t: &mut f64,
-        y: &mut [f64; N],
+        (t, y): (&mut f64, &mut [f64; N]),
         t_end: f64,
     ) {
         let mut ahead = Ahead {
@@ -648,164 +532,7 @@ impl<const N: usize> Solver<N> {
             left_off: LeftOff::at(t_end, y),
         };
         ahead.serve(t, y, t_end);
-        self.ahead = Some(ahead);
-    }
-
-    /// One step of size h from (t, y) with the current method: accepted (with the edge it
-    /// leaves its piece through, if any) or rejected with the step size to retry with.
-    fn attempt<S: Piecewise<N> + Jacobian<N>>(
-        &mut self,
-        sys: &mut S,
-        at: Start<N>,
-        h: f64,
-        trial_buffer: &mut dopri5::Trial<N>,
-    ) -> Result<Accepted<N>, f64> {
-        let (lo, hi) = sys.piece();
-        let guard = (S::GUARD, S::RATE);
-        if self.implicit {
-            let trial = self.implicit_step(sys, at, h);
-            let verdict = self.stepper.judge(&trial);
-            if !verdict.accept {
-                return Err(verdict.h_next);
-            }
-            sys.observe(at.t, h, &trial);
-            Ok(Accepted {
-                y1: trial.y1,
-                explicit: false,
-                h_next: verdict.h_next,
-                edge: locate_edge(&trial, guard, lo, hi),
-                h_rho: 0.0,
-            })
-        } else {
-            self.explicit_step(sys, at, h, trial_buffer);
-            let trial = &*trial_buffer;
-            let mut err = self.tol.norm(&trial.y0, &trial.y1, &trial.err);
-            if self.just_crossed && sys.rough_start() {
-                err *= FIRST_STEP_DISTRUST;
-            }
-            let verdict = self.controller.judge(err, h);
-            if !verdict.accept {
-                return Err(verdict.h_next);
-            }
-            sys.observe(at.t, h, trial);
-            Ok(Accepted {
-                y1: trial.y1,
-                h_next: verdict.h_next,
-                edge: locate_edge(trial, guard, lo, hi),
-                h_rho: if self.method == Method::Auto {
-                    stiffness(trial, &self.tol)
-                } else {
-                    0.0
-                },
-                explicit: true,
-            })
-        }
-    }
-
-    /// The step redone with size h to end on an edge; None if Radau's Newton iteration fails
-    /// on it.
-    fn redo<S: Piecewise<N> + Jacobian<N>>(
-        &mut self,
-        sys: &S,
-        at: Start<N>,
-        h: f64,
-        trial: &mut dopri5::Trial<N>,
-    ) -> Option<[f64; N]> {
-        if self.implicit {
-            let trial = self.implicit_step(sys, at, h);
-            trial.converged().then_some(trial.y1)
-        } else {
-            self.explicit_step(sys, at, h, trial);
-            Some(trial.y1)
-        }
-    }
-
-    /// A DOPRI5 trial into `trial`, with its work counted.
-    fn explicit_step<S: Piecewise<N>>(
-        &mut self,
-        sys: &S,
-        at: Start<N>,
-        h: f64,
-        trial: &mut dopri5::Trial<N>,
-    ) {
-        self.stats.rhs_evals += EVALS_PER_STEP;
-        dopri5::step(sys, at.t, at.y, at.k1, h, self.tol.controlled, trial);
-    }
-
-    /// A Radau IIA trial, with its work counted and the spectral radius of a new Jacobian
-    /// taken (once per Jacobian: it is what the way back to DOPRI5 is judged by).
-    fn implicit_step<S: Jacobian<N>>(&mut self, sys: &S, at: Start<N>, h: f64) -> RadauTrial<N> {
-        let before = self.stepper.stats;
-        let trial = self.stepper.step(sys, at.t, at.y, at.k1, h);
-        let after = self.stepper.stats;
-        self.stats.rhs_evals += after.rhs_evals - before.rhs_evals;
-        self.stats.jacobians += after.jacobians - before.jacobians;
-        self.stats.decompositions += after.decompositions - before.decompositions;
-        if after.jacobians != self.rho_of
-            && let Some(j) = self.stepper.jacobian()
-        {
-            self.rho = spectral_radius(j);
-            self.rho_of = after.jacobians;
-        }
-        trial
-    }
-
-    /// After an accepted step that did not cross an edge: the hand-over of [`Method::Auto`].
-    /// To Radau IIA (afresh) when DOPRI5 has been held back by stability; back to DOPRI5 (a
-    /// fresh controller, Radau's step size) when Radau's steps are within DOPRI5's stability.
-    fn hand_over(&mut self, explicit_h_rho: f64) {
-        if self.method != Method::Auto {
-            return;
-        }
-        if self.implicit {
-            if self.switch.to_explicit(self.h * self.rho) {
-                self.implicit = false;
-                self.controller = Controller::default();
-                self.stats.switches += 1;
-            }
-        } else if self.switch.to_implicit(explicit_h_rho) {
-            self.implicit = true;
-            self.stepper.invalidate();
-            self.stats.switches += 1;
-        }
-    }
-
-    /// Hairer's starting step: from the sizes of y, f and an estimate of f', capped.
-    fn initial_step<S: Piecewise<N>>(
-        &mut self,
-        sys: &S,
-        t: f64,
-        y: &[f64; N],
-        f0: &[f64; N],
-        h_max: f64,
-    ) -> f64 {
-        let n = self.tol.controlled;
-        let scale = |i: usize| self.tol.atol[i] + self.tol.rtol * y[i].abs();
-        let rms = |v: &dyn Fn(usize) -> f64| {
-            ((0..n).map(|i| v(i).powi(2)).sum::<f64>() / n as f64).sqrt()
-        };
-        let dny = rms(&|i| y[i] / scale(i));
-        let dnf = rms(&|i| f0[i] / scale(i));
-        let mut h = if dny <= 1e-10 || dnf <= 1e-10 {
-            1e-6
-        } else {
-            0.01 * dny / dnf
-        };
-        h = h.min(h_max);
-        let mut y1 = *y;
-        for i in 0..N {
-            y1[i] += h * f0[i];
-        }
-        let f1 = sys.rhs(t + h, &y1);
-        self.stats.rhs_evals += 1;
-        let der2 = rms(&|i| (f1[i] - f0[i]) / scale(i)) / h;
-        let der12 = der2.max(dnf);
-        let h1 = if der12 <= 1e-15 {
-            (h * 1e-3).max(1e-6)
-        } else {
-            (0.01 / der12).powf(0.2)
-        };
-        (100.0 * h).min(h1).min(h_max)
+        self.kept = Some(Kept::Step(ahead));
     }
 }
 

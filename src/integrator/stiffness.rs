@@ -16,6 +16,7 @@ use serde::{Deserialize, Serialize};
 
 use super::control::Tolerance;
 use super::dopri5;
+use super::options::OPTIONS;
 
 /// Spectral radius max |λ| of a Jacobian (Schur decomposition; infinite if J is not finite).
 /// With the step size h of the implicit method, h·ρ(J) tells whether DOPRI5 could take that
@@ -54,17 +55,14 @@ pub fn stiffness<const N: usize>(trial: &dopri5::Trial<N>, tol: &Tolerance<N>) -
     }
 }
 
-/// The threshold of h·ρ, both ways. Hairer's DOPRI5 takes 3.25, the radius of DOPRI5's
-/// stability domain on the negative real axis (3.3); but the radius shrinks towards the
-/// imaginary axis: 3.3 for real eigenvalues, 3.0 for a contact mode with damping ratio ζ = 0.2
-/// (where DOPRI5's steps hover at h·|λ| = 3.0 ± 0.6 on a resting contact, so that 3.25 would
-/// never fire), 2.6 for ζ = 0.09, 2.3 for ζ = 0.035. An accepted step with h·|λ| > 2 leaves
-/// that mode an error of about (h·|λ|)⁶/720 ≈ 9 % of its amplitude per step: it is accepted
-/// only when the mode has died out, which is what stiffness means.
-pub const STIFF_H_RHO: f64 = 2.0;
-/// Stiff verdicts (not interrupted by 6 non-stiff ones in a row) that make a problem stiff.
-pub const STIFF_STEPS: u32 = 15;
-const CALM_STEPS: u32 = 6;
+/// The threshold of h·ρ, both ways ([`OPTIONS`]`.stiff_h_rho`). An accepted step with
+/// h·|λ| > 2 leaves that mode an error of about (h·|λ|)⁶/720 ≈ 9 % of its amplitude per step:
+/// it is accepted only when the mode has died out, which is what stiffness means.
+pub const STIFF_H_RHO: f64 = OPTIONS.stiff_h_rho;
+/// Stiff verdicts (not interrupted by `CALM_STEPS` non-stiff ones in a row) that make a
+/// problem stiff.
+pub const STIFF_STEPS: u32 = OPTIONS.stiff_steps;
+const CALM_STEPS: u32 = OPTIONS.calm_steps;
 
 /// Hairer's DOPRI5 switching rule, fed with [`stiffness`] of each accepted step: stiff after
 /// 15 verdicts h·ρ > [`STIFF_H_RHO`], the count restarting after 6 non-stiff verdicts in a

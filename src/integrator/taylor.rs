@@ -6,23 +6,18 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::options::OPTIONS;
 use super::{Dense, Tolerance};
 use crate::math;
 
-/// Number of Taylor coefficients per component: order 11. Near orders cost about the same
-/// at equal error on S1 (docs/DECISIONS.md, D2).
-pub const TERMS: usize = 12;
+/// Number of Taylor coefficients per component ([`OPTIONS`]`.taylor_terms`).
+pub const TERMS: usize = OPTIONS.taylor_terms;
 
 /// y_i(t + τ) = Σ_k c[k][i] τ^k, k < [`TERMS`].
 pub type Coefficients<const N: usize> = [[f64; N]; TERMS];
 
-/// Share of the error weights (atol + rtol·|y|) given to a step's truncation error, the
-/// series' last two terms. DOPRI5's weight bounds its embedded 4th-order estimate, which
-/// overstates the error of the 5th-order solution it propagates; the last terms of a series
-/// are close to its truncation error, hence a smaller share. With a share of 1, S2's impact
-/// rates fall outside what `test_sine_s2_statistics` (tests/python/test_fmu_sine.py) allows;
-/// above 0.1 the contacts' share of S1's error grows (docs/DECISIONS.md, D2).
-pub const SHARE: f64 = 0.1;
+/// Share of the error weights given to a step's last two terms ([`OPTIONS`]`.taylor_share`).
+const SHARE: f64 = OPTIONS.taylor_share;
 
 /// One step of length h from its coefficients, with its end.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -36,10 +31,16 @@ pub struct Step<const N: usize> {
 
 impl<const N: usize> Step<N> {
     /// The step of length h from the series `c` about its start.
+    #[inline]
     pub fn new(c: Coefficients<N>, h: f64) -> Self {
         let mut step = Step { h, c, y1: [0.0; N] };
         step.y1 = step.at(1.0);
         step
+    }
+
+    /// The same series cut to end at θ ∈ [0, 1] of the step.
+    pub fn cut(&self, theta: f64) -> Self {
+        Step::new(self.c, theta * self.h)
     }
 
     /// The longest step for the tolerance: for each controlled component with weight
