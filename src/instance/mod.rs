@@ -14,7 +14,7 @@ use crate::physics::Shaft;
 use crate::rattle::Impacts;
 use fmi2_shell::values::Values;
 use fmi2_shell::{EventInfo, Identity, Interface, Log, Slave};
-use model_exchange::{NX, NZ};
+use model_exchange::NX;
 use serde::{Deserialize, Serialize};
 
 /// The contract's log categories by role (errors and warnings first, as the shell wants).
@@ -55,6 +55,13 @@ enum StepRefusal {
     Time,
     /// t + h − t misses h by more than 0.1 % (the value it has).
     Resolution(f64),
+}
+
+/// Copies a vector of the model into the importer's array, refused if the lengths differ.
+fn fill<const K: usize>(what: &str, out: &mut [f64], value: [f64; K]) -> FmiResult {
+    Instance::length(what, out.len(), K)?;
+    out.copy_from_slice(&value);
+    Ok(())
 }
 
 impl Instance {
@@ -629,27 +636,19 @@ impl Slave for Instance {
     }
 
     fn get_continuous_states(&mut self, x: &mut [f64]) -> FmiResult {
-        Self::length("x", x.len(), NX)?;
-        x.copy_from_slice(&self.current()?.continuous_states());
-        Ok(())
+        fill("x", x, self.current()?.continuous_states())
     }
 
     fn get_nominals_of_continuous_states(&mut self, x: &mut [f64]) -> FmiResult {
-        Self::length("x_nominal", x.len(), NX)?;
-        x.copy_from_slice(&self.current()?.nominals());
-        Ok(())
+        fill("x_nominal", x, self.current()?.nominals())
     }
 
     fn get_derivatives(&mut self, dx: &mut [f64]) -> FmiResult {
-        Self::length("derivatives", dx.len(), NX)?;
-        dx.copy_from_slice(&self.current()?.derivatives());
-        Ok(())
+        fill("derivatives", dx, self.current()?.derivatives())
     }
 
     fn get_event_indicators(&mut self, z: &mut [f64]) -> FmiResult {
-        Self::length("eventIndicators", z.len(), NZ)?;
-        z.copy_from_slice(&self.current()?.event_indicators());
-        Ok(())
+        fill("eventIndicators", z, self.current()?.event_indicators())
     }
 
     fn enter_event_mode(&mut self) -> FmiResult {

@@ -20,7 +20,7 @@
 use super::simulation::{Drive, Gear, Simulation};
 use crate::physics::{Excitation, Polynomial, Region, Shaft};
 use crate::rattle::window::quadrature;
-use crate::rattle::{GearPair, Rattle, XI, XI_DOT, quadrature_rates, torque};
+use crate::rattle::{GearPair, XI, XI_DOT, quadrature_rates, torque};
 
 /// Number of continuous states.
 pub const NX: usize = 4 + quadrature::COUNT;
@@ -37,20 +37,13 @@ fn nominals(G: f64) -> [f64; NX] {
 impl Simulation {
     /// The continuous states x.
     pub fn continuous_states(&self) -> [f64; NX] {
+        let now = self.now();
         let mut x = [0.0; NX];
-        match &self.gear {
-            Gear::Kinematic(k) => {
-                x[0] = k.y[XI];
-                x[1] = k.system.loads_at(self.t, &k.y).omega_L;
-                x[4..].copy_from_slice(&Rattle::quadratures(&k.y));
-            }
-            Gear::Torque(k) => {
-                x[0] = k.y[XI];
-                x[1] = k.system.loads_at(self.t, &k.y).omega_L;
-                (x[2], x[3]) = (k.y[torque::THETA_M], k.y[torque::OMEGA_M]);
-                x[4..].copy_from_slice(&torque::TorqueRattle::quadratures(&k.y));
-            }
+        (x[0], x[1]) = (now.xi, now.loads(&self.shaft()).omega_L);
+        if let Gear::Torque(k) = &self.gear {
+            (x[2], x[3]) = (k.y[torque::THETA_M], k.y[torque::OMEGA_M]);
         }
+        x[4..].copy_from_slice(&now.quadratures);
         x
     }
 
@@ -110,29 +103,18 @@ impl Simulation {
     /// steps changes no edge's sign at the step's ends, but has a turning point in the band:
     /// the event there finds ξ past the edge and counts the impact.
     pub fn event_indicators(&self) -> [f64; NZ] {
-        let (xi, xi_dot, p, region) = match &self.gear {
-            Gear::Kinematic(k) => (
-                k.y[XI],
-                k.y[XI_DOT],
-                &k.system.dynamics.params,
-                k.system.region,
-            ),
-            Gear::Torque(k) => (
-                k.y[XI],
-                k.y[XI_DOT],
-                &k.system.dynamics.params,
-                k.system.region,
-            ),
+        let now = self.now();
+        let (xi, p) = (now.xi, &now.dynamics.params);
+        let turning = if now.region == Region::Gap {
+            now.xi_dot
+        } else {
+            1.0
         };
-        let turning = if region == Region::Gap { xi_dot } else { 1.0 };
         [xi + p.epsilon, xi, xi - p.G, xi - p.G - p.epsilon, turning]
     }
 
     pub fn nominals(&self) -> [f64; NX] {
-        nominals(match &self.gear {
-            Gear::Kinematic(k) => k.system.dynamics.params.G,
-            Gear::Torque(k) => k.system.dynamics.params.G,
-        })
+        nominals(self.now().dynamics.params.G)
     }
 
     /// The importer's time. In the inputs mode the shaft's inputs hold until set again.

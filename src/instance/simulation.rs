@@ -124,21 +124,21 @@ pub struct Simulation {
 
 /// What every output is computed from at the current time, whichever the coupling (the
 /// shaft's motion apart: [`Simulation::shaft`], computed only for the outputs that need it).
-struct Now<'a> {
-    dynamics: &'a Dynamics,
-    region: Region,
-    impacts: &'a Impacts,
-    xi: f64,
-    xi_dot: f64,
-    quadratures: Quadratures,
-    window: &'a Window,
-    stats: &'a Stats,
+pub(super) struct Now<'a> {
+    pub(super) dynamics: &'a Dynamics,
+    pub(super) region: Region,
+    pub(super) impacts: &'a Impacts,
+    pub(super) xi: f64,
+    pub(super) xi_dot: f64,
+    pub(super) quadratures: Quadratures,
+    pub(super) window: &'a Window,
+    pub(super) stats: &'a Stats,
     /// Radau IIA is stepping now.
-    implicit: bool,
+    pub(super) implicit: bool,
 }
 
 impl Now<'_> {
-    fn loads(&self, shaft: &Shaft) -> crate::physics::Loads {
+    pub(super) fn loads(&self, shaft: &Shaft) -> crate::physics::Loads {
         self.dynamics
             .loads(self.region, self.xi, self.xi_dot, shaft)
     }
@@ -302,7 +302,7 @@ impl Simulation {
     }
 
     /// The state the outputs are computed from, now.
-    fn now(&self) -> Now<'_> {
+    pub(super) fn now(&self) -> Now<'_> {
         match &self.gear {
             Gear::Kinematic(k) => k.now(),
             Gear::Torque(k) => k.now(),
