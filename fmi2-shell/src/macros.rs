@@ -8,31 +8,37 @@
 //! [`allowed`]: crate::state::allowed
 //! [`guard`]: crate::component::guard
 
-/// Defines guarded exports for the slave type `$slave`: each
-/// `fn fmi2Name(args after the component) ALLOWED |slave| body;` becomes
+/// Defines the module `$module` of exports for the slave type `$slave`: the `items` as they
+/// are, then each `fn fmi2Name(args after the component) ALLOWED |slave| body;` as
 /// `fmi2Name(fmi2Component c, args)`, which runs `body` through the guard under the name
 /// "fmi2Name" with the mask `allowed::ALLOWED`. Pointer arguments are the importer's, each
 /// valid for the length the call gives (FMI's contract); the bodies turn them into slices
 /// with [`slice`](crate::component::slice), which refuses a NULL one.
 #[doc(hidden)]
 #[macro_export]
-macro_rules! guarded {
-    ($slave:ty; $(
+macro_rules! exports {
+    (mod $module:ident for $slave:ty; { $($items:item)* } $(
         fn $name:ident($($arg:ident: $ty:ty),* $(,)?) $allowed:ident |$s:pat_param| $body:expr;
-    )*) => {$(
-        #[unsafe(no_mangle)]
-        pub unsafe extern "C" fn $name(
-            c: $crate::fmi2::fmi2Component,
-            $($arg: $ty),*
-        ) -> $crate::fmi2::fmi2Status {
-            $crate::component::guard(
-                c,
-                stringify!($name),
-                $crate::state::allowed::$allowed,
-                |$s: &mut $slave| $body,
-            )
+    )*) => {
+        mod $module {
+            #![allow(non_snake_case, clippy::missing_safety_doc)]
+            use super::*;
+            use $crate::component::{slice, slice_mut};
+            use $crate::export as e;
+            use $crate::fmi2::*;
+            use $crate::slave::Slave as _;
+            use $crate::status::FmiError;
+            type S = $slave;
+
+            $($items)*
+            $(
+                #[unsafe(no_mangle)]
+                pub unsafe extern "C" fn $name(c: fmi2Component, $($arg: $ty),*) -> fmi2Status {
+                    $crate::component::guard(c, stringify!($name), $crate::state::allowed::$allowed, |$s: &mut S| $body)
+                }
+            )*
         }
-    )*};
+    };
 }
 
 /// Exports every function of FMI 2.0 Co-Simulation for the slave type `$slave` (importers
@@ -40,17 +46,10 @@ macro_rules! guarded {
 #[macro_export]
 macro_rules! export_co_simulation {
     ($slave:ty) => {
-        mod fmi2_exports {
-            #![allow(non_snake_case, clippy::missing_safety_doc)]
-            use super::*;
+        $crate::exports! { mod fmi2_exports for $slave; {
             use ::std::ffi::c_char;
-            use $crate::component::{slice, slice_mut};
-            use $crate::export as e;
-            use $crate::fmi2::*;
             use $crate::fmu_state;
-            use $crate::slave::{Slave as _, reset, restore, snapshot};
-            use $crate::status::FmiError;
-            type S = $slave;
+            use $crate::slave::{reset, restore, snapshot};
 
             #[unsafe(no_mangle)]
             pub extern "C" fn fmi2GetTypesPlatform() -> *const c_char {
@@ -76,113 +75,112 @@ macro_rules! export_co_simulation {
             pub unsafe extern "C" fn fmi2FreeInstance(c: fmi2Component) {
                 unsafe { e::free_instance::<S>(c) }
             }
-
-            $crate::guarded! { S;
-                fn fmi2SetDebugLogging(loggingOn: fmi2Boolean, nCategories: usize, categories: *const fmi2String)
-                    SET_DEBUG_LOGGING |s| {
-                        let names = unsafe { e::category_names(categories, nCategories) }?;
-                        s.log().set_debug_logging(loggingOn != 0, &names)
-                    };
-                fn fmi2SetupExperiment(toleranceDefined: fmi2Boolean, tolerance: fmi2Real, startTime: fmi2Real,
-                    _stopTimeDefined: fmi2Boolean, _stopTime: fmi2Real)
-                    SETUP_EXPERIMENT |s| s.setup_experiment((toleranceDefined != 0).then_some(tolerance), startTime);
-                fn fmi2EnterInitializationMode() ENTER_INITIALIZATION_MODE |s| s.enter_initialization_mode();
-                fn fmi2ExitInitializationMode() EXIT_INITIALIZATION_MODE |s| s.exit_initialization_mode();
-                fn fmi2Terminate() TERMINATE |s| s.terminate();
-                fn fmi2Reset() RESET |s| {
-                    reset(s);
-                    Ok(())
-                };
-
-                fn fmi2GetReal(vr: *const fmi2ValueReference, nvr: usize, value: *mut fmi2Real)
-                    GET |s| s.get_real(unsafe { slice(vr, nvr, "vr") }?, unsafe { slice_mut(value, nvr, "value") }?);
-                fn fmi2GetInteger(vr: *const fmi2ValueReference, nvr: usize, value: *mut fmi2Integer)
-                    GET |s| s.get_integer(unsafe { slice(vr, nvr, "vr") }?, unsafe { slice_mut(value, nvr, "value") }?);
-                fn fmi2GetBoolean(vr: *const fmi2ValueReference, nvr: usize, _value: *mut fmi2Boolean)
-                    GET |_| e::no_variables("Boolean", unsafe { slice(vr, nvr, "vr") }?);
-                fn fmi2GetString(vr: *const fmi2ValueReference, nvr: usize, _value: *mut fmi2String)
-                    GET |_| e::no_variables("String", unsafe { slice(vr, nvr, "vr") }?);
-                fn fmi2SetReal(vr: *const fmi2ValueReference, nvr: usize, value: *const fmi2Real)
-                    SET |s| s.set_real(unsafe { slice(vr, nvr, "vr") }?, unsafe { slice(value, nvr, "value") }?);
-                fn fmi2SetInteger(vr: *const fmi2ValueReference, nvr: usize, value: *const fmi2Integer)
-                    SET |s| s.set_integer(unsafe { slice(vr, nvr, "vr") }?, unsafe { slice(value, nvr, "value") }?);
-                fn fmi2SetBoolean(vr: *const fmi2ValueReference, nvr: usize, _value: *const fmi2Boolean)
-                    SET |_| e::no_variables("Boolean", unsafe { slice(vr, nvr, "vr") }?);
-                fn fmi2SetString(vr: *const fmi2ValueReference, nvr: usize, _value: *const fmi2String)
-                    SET |_| e::no_variables("String", unsafe { slice(vr, nvr, "vr") }?);
-
-                fn fmi2DoStep(currentCommunicationPoint: fmi2Real, communicationStepSize: fmi2Real,
-                    _noSetFMUStatePriorToCurrentPoint: fmi2Boolean)
-                    DO_STEP |s| s.do_step(currentCommunicationPoint, communicationStepSize);
-                fn fmi2CancelStep() CANCEL_STEP |_| Ok(());
-                fn fmi2GetStatus(kind: fmi2StatusKind, _value: *mut fmi2Status)
-                    GET_STATUS |_| e::unavailable(kind);
-                fn fmi2GetRealStatus(kind: fmi2StatusKind, value: *mut fmi2Real) GET_STATUS |s| unsafe {
-                    e::status(kind, fmi2StatusKind_fmi2LastSuccessfulTime, value, s.last_successful_time())
-                };
-                fn fmi2GetIntegerStatus(kind: fmi2StatusKind, _value: *mut fmi2Integer)
-                    GET_STATUS |_| e::unavailable(kind);
-                // The slave never asks the master to end the simulation.
-                fn fmi2GetBooleanStatus(kind: fmi2StatusKind, value: *mut fmi2Boolean)
-                    GET_STATUS |_| unsafe { e::status(kind, fmi2StatusKind_fmi2Terminated, value, 0) };
-                fn fmi2GetStringStatus(kind: fmi2StatusKind, _value: *mut fmi2String)
-                    GET_STATUS |_| e::unavailable(kind);
-
-                fn fmi2GetFMUstate(state: *mut fmi2FMUstate)
-                    FMU_STATE |s| unsafe { fmu_state::store(state, snapshot(s)) };
-                fn fmi2SetFMUstate(state: fmi2FMUstate) FMU_STATE |s| {
-                    restore(s, &unsafe { fmu_state::get::<S>(state) }?.slave);
-                    Ok(())
-                };
-                fn fmi2FreeFMUstate(state: *mut fmi2FMUstate)
-                    FMU_STATE |_| unsafe { fmu_state::free::<S>(state) };
-                fn fmi2SerializedFMUstateSize(state: fmi2FMUstate, size: *mut usize) FMU_STATE |_| {
-                    let saved = unsafe { fmu_state::get::<S>(state) }?;
-                    unsafe { slice_mut(size, 1, "size") }?[0] = fmu_state::serialize(&saved.slave).len();
-                    Ok(())
-                };
-                fn fmi2SerializeFMUstate(state: fmi2FMUstate, bytes: *mut fmi2Byte, size: usize) FMU_STATE |_| {
-                    let data = fmu_state::serialize(&unsafe { fmu_state::get::<S>(state) }?.slave);
-                    if data.len() != size {
-                        return Err(FmiError::error(format!(
-                            "size {size} given, the serialized state has {} bytes (fmi2SerializedFMUstateSize)",
-                            data.len()
-                        )));
-                    }
-                    unsafe { slice_mut(bytes as *mut u8, size, "serializedState") }?.copy_from_slice(&data);
-                    Ok(())
-                };
-                fn fmi2DeSerializeFMUstate(bytes: *const fmi2Byte, size: usize, state: *mut fmi2FMUstate)
-                    FMU_STATE |_| {
-                        let data = unsafe { slice(bytes as *const u8, size, "serializedState") }?;
-                        let slave = fmu_state::deserialize::<S>(data)?;
-                        unsafe { fmu_state::store(state, slave) }
-                    };
-
-                fn fmi2GetDirectionalDerivative(vUnknown_ref: *const fmi2ValueReference, nUnknown: usize,
-                    vKnown_ref: *const fmi2ValueReference, nKnown: usize, dvKnown: *const fmi2Real,
-                    dvUnknown: *mut fmi2Real)
-                    GET |s| s.directional_derivative(
-                        unsafe { slice(vUnknown_ref, nUnknown, "vUnknown_ref") }?,
-                        unsafe { slice(vKnown_ref, nKnown, "vKnown_ref") }?,
-                        unsafe { slice(dvKnown, nKnown, "dvKnown") }?,
-                        unsafe { slice_mut(dvUnknown, nUnknown, "dvUnknown") }?,
-                    );
-                fn fmi2SetRealInputDerivatives(vr: *const fmi2ValueReference, nvr: usize,
-                    order: *const fmi2Integer, value: *const fmi2Real)
-                    SET |s| s.set_input_derivatives(
-                        unsafe { slice(vr, nvr, "vr") }?,
-                        unsafe { slice(order, nvr, "order") }?,
-                        unsafe { slice(value, nvr, "value") }?,
-                    );
-                fn fmi2GetRealOutputDerivatives(vr: *const fmi2ValueReference, nvr: usize,
-                    order: *const fmi2Integer, value: *mut fmi2Real)
-                    GET |s| s.get_output_derivatives(
-                        unsafe { slice(vr, nvr, "vr") }?,
-                        unsafe { slice(order, nvr, "order") }?,
-                        unsafe { slice_mut(value, nvr, "value") }?,
-                    );
             }
+
+            fn fmi2SetDebugLogging(loggingOn: fmi2Boolean, nCategories: usize, categories: *const fmi2String)
+                SET_DEBUG_LOGGING |s| {
+                    let names = unsafe { e::category_names(categories, nCategories) }?;
+                    s.log().set_debug_logging(loggingOn != 0, &names)
+                };
+            fn fmi2SetupExperiment(toleranceDefined: fmi2Boolean, tolerance: fmi2Real, startTime: fmi2Real,
+                _stopTimeDefined: fmi2Boolean, _stopTime: fmi2Real)
+                SETUP_EXPERIMENT |s| s.setup_experiment((toleranceDefined != 0).then_some(tolerance), startTime);
+            fn fmi2EnterInitializationMode() ENTER_INITIALIZATION_MODE |s| s.enter_initialization_mode();
+            fn fmi2ExitInitializationMode() EXIT_INITIALIZATION_MODE |s| s.exit_initialization_mode();
+            fn fmi2Terminate() TERMINATE |s| s.terminate();
+            fn fmi2Reset() RESET |s| {
+                reset(s);
+                Ok(())
+            };
+
+            fn fmi2GetReal(vr: *const fmi2ValueReference, nvr: usize, value: *mut fmi2Real)
+                GET |s| s.get_real(unsafe { slice(vr, nvr, "vr") }?, unsafe { slice_mut(value, nvr, "value") }?);
+            fn fmi2GetInteger(vr: *const fmi2ValueReference, nvr: usize, value: *mut fmi2Integer)
+                GET |s| s.get_integer(unsafe { slice(vr, nvr, "vr") }?, unsafe { slice_mut(value, nvr, "value") }?);
+            fn fmi2GetBoolean(vr: *const fmi2ValueReference, nvr: usize, _value: *mut fmi2Boolean)
+                GET |_| e::no_variables("Boolean", unsafe { slice(vr, nvr, "vr") }?);
+            fn fmi2GetString(vr: *const fmi2ValueReference, nvr: usize, _value: *mut fmi2String)
+                GET |_| e::no_variables("String", unsafe { slice(vr, nvr, "vr") }?);
+            fn fmi2SetReal(vr: *const fmi2ValueReference, nvr: usize, value: *const fmi2Real)
+                SET |s| s.set_real(unsafe { slice(vr, nvr, "vr") }?, unsafe { slice(value, nvr, "value") }?);
+            fn fmi2SetInteger(vr: *const fmi2ValueReference, nvr: usize, value: *const fmi2Integer)
+                SET |s| s.set_integer(unsafe { slice(vr, nvr, "vr") }?, unsafe { slice(value, nvr, "value") }?);
+            fn fmi2SetBoolean(vr: *const fmi2ValueReference, nvr: usize, _value: *const fmi2Boolean)
+                SET |_| e::no_variables("Boolean", unsafe { slice(vr, nvr, "vr") }?);
+            fn fmi2SetString(vr: *const fmi2ValueReference, nvr: usize, _value: *const fmi2String)
+                SET |_| e::no_variables("String", unsafe { slice(vr, nvr, "vr") }?);
+
+            fn fmi2DoStep(currentCommunicationPoint: fmi2Real, communicationStepSize: fmi2Real,
+                _noSetFMUStatePriorToCurrentPoint: fmi2Boolean)
+                DO_STEP |s| s.do_step(currentCommunicationPoint, communicationStepSize);
+            fn fmi2CancelStep() CANCEL_STEP |_| Ok(());
+            fn fmi2GetStatus(kind: fmi2StatusKind, _value: *mut fmi2Status)
+                GET_STATUS |_| e::unavailable(kind);
+            fn fmi2GetRealStatus(kind: fmi2StatusKind, value: *mut fmi2Real) GET_STATUS |s| unsafe {
+                e::status(kind, fmi2StatusKind_fmi2LastSuccessfulTime, value, s.last_successful_time())
+            };
+            fn fmi2GetIntegerStatus(kind: fmi2StatusKind, _value: *mut fmi2Integer)
+                GET_STATUS |_| e::unavailable(kind);
+            // The slave never asks the master to end the simulation.
+            fn fmi2GetBooleanStatus(kind: fmi2StatusKind, value: *mut fmi2Boolean)
+                GET_STATUS |_| unsafe { e::status(kind, fmi2StatusKind_fmi2Terminated, value, 0) };
+            fn fmi2GetStringStatus(kind: fmi2StatusKind, _value: *mut fmi2String)
+                GET_STATUS |_| e::unavailable(kind);
+
+            fn fmi2GetFMUstate(state: *mut fmi2FMUstate)
+                FMU_STATE |s| unsafe { fmu_state::store(state, snapshot(s)) };
+            fn fmi2SetFMUstate(state: fmi2FMUstate) FMU_STATE |s| {
+                restore(s, &unsafe { fmu_state::get::<S>(state) }?.slave);
+                Ok(())
+            };
+            fn fmi2FreeFMUstate(state: *mut fmi2FMUstate)
+                FMU_STATE |_| unsafe { fmu_state::free::<S>(state) };
+            fn fmi2SerializedFMUstateSize(state: fmi2FMUstate, size: *mut usize) FMU_STATE |_| {
+                let saved = unsafe { fmu_state::get::<S>(state) }?;
+                unsafe { slice_mut(size, 1, "size") }?[0] = fmu_state::serialize(&saved.slave).len();
+                Ok(())
+            };
+            fn fmi2SerializeFMUstate(state: fmi2FMUstate, bytes: *mut fmi2Byte, size: usize) FMU_STATE |_| {
+                let data = fmu_state::serialize(&unsafe { fmu_state::get::<S>(state) }?.slave);
+                if data.len() != size {
+                    return Err(FmiError::error(format!(
+                        "size {size} given, the serialized state has {} bytes (fmi2SerializedFMUstateSize)",
+                        data.len()
+                    )));
+                }
+                unsafe { slice_mut(bytes as *mut u8, size, "serializedState") }?.copy_from_slice(&data);
+                Ok(())
+            };
+            fn fmi2DeSerializeFMUstate(bytes: *const fmi2Byte, size: usize, state: *mut fmi2FMUstate)
+                FMU_STATE |_| {
+                    let data = unsafe { slice(bytes as *const u8, size, "serializedState") }?;
+                    let slave = fmu_state::deserialize::<S>(data)?;
+                    unsafe { fmu_state::store(state, slave) }
+                };
+
+            fn fmi2GetDirectionalDerivative(vUnknown_ref: *const fmi2ValueReference, nUnknown: usize,
+                vKnown_ref: *const fmi2ValueReference, nKnown: usize, dvKnown: *const fmi2Real,
+                dvUnknown: *mut fmi2Real)
+                GET |s| s.directional_derivative(
+                    unsafe { slice(vUnknown_ref, nUnknown, "vUnknown_ref") }?,
+                    unsafe { slice(vKnown_ref, nKnown, "vKnown_ref") }?,
+                    unsafe { slice(dvKnown, nKnown, "dvKnown") }?,
+                    unsafe { slice_mut(dvUnknown, nUnknown, "dvUnknown") }?,
+                );
+            fn fmi2SetRealInputDerivatives(vr: *const fmi2ValueReference, nvr: usize,
+                order: *const fmi2Integer, value: *const fmi2Real)
+                SET |s| s.set_input_derivatives(
+                    unsafe { slice(vr, nvr, "vr") }?,
+                    unsafe { slice(order, nvr, "order") }?,
+                    unsafe { slice(value, nvr, "value") }?,
+                );
+            fn fmi2GetRealOutputDerivatives(vr: *const fmi2ValueReference, nvr: usize,
+                order: *const fmi2Integer, value: *mut fmi2Real)
+                GET |s| s.get_output_derivatives(
+                    unsafe { slice(vr, nvr, "vr") }?,
+                    unsafe { slice(order, nvr, "order") }?,
+                    unsafe { slice_mut(value, nvr, "value") }?,
+                );
         }
     };
 }
@@ -192,51 +190,40 @@ macro_rules! export_co_simulation {
 #[macro_export]
 macro_rules! export_model_exchange {
     ($slave:ty) => {
-        mod fmi2_model_exchange_exports {
-            #![allow(non_snake_case, clippy::missing_safety_doc)]
-            use super::*;
-            use $crate::component::{slice, slice_mut};
-            use $crate::export as e;
-            use $crate::fmi2::*;
-            use $crate::slave::Slave as _;
-            use $crate::status::FmiError;
-            type S = $slave;
-
-            $crate::guarded! { S;
-                fn fmi2SetTime(time: fmi2Real) SET_TIME |s| s.set_time(time);
-                fn fmi2SetContinuousStates(x: *const fmi2Real, nx: usize)
-                    SET_CONTINUOUS_STATES |s| s.set_continuous_states(unsafe { slice(x, nx, "x") }?);
-                fn fmi2EnterEventMode() ENTER_EVENT_MODE |s| s.enter_event_mode();
-                fn fmi2NewDiscreteStates(info: *mut fmi2EventInfo) NEW_DISCRETE_STATES |s| {
-                    let Some(out) = (unsafe { info.as_mut() }) else {
-                        return Err(FmiError::error("fmi2EventInfo is NULL"));
-                    };
-                    e::event_info(s.new_discrete_states()?, out);
+        $crate::exports! { mod fmi2_model_exchange_exports for $slave; {}
+            fn fmi2SetTime(time: fmi2Real) SET_TIME |s| s.set_time(time);
+            fn fmi2SetContinuousStates(x: *const fmi2Real, nx: usize)
+                SET_CONTINUOUS_STATES |s| s.set_continuous_states(unsafe { slice(x, nx, "x") }?);
+            fn fmi2EnterEventMode() ENTER_EVENT_MODE |s| s.enter_event_mode();
+            fn fmi2NewDiscreteStates(info: *mut fmi2EventInfo) NEW_DISCRETE_STATES |s| {
+                let Some(out) = (unsafe { info.as_mut() }) else {
+                    return Err(FmiError::error("fmi2EventInfo is NULL"));
+                };
+                e::event_info(s.new_discrete_states()?, out);
+                Ok(())
+            };
+            fn fmi2EnterContinuousTimeMode() ENTER_CONTINUOUS_TIME_MODE |s| s.enter_continuous_time_mode();
+            // Pointers that are NULL are not written.
+            fn fmi2CompletedIntegratorStep(_noSetFMUStatePriorToCurrentPoint: fmi2Boolean,
+                enterEventMode: *mut fmi2Boolean, terminateSimulation: *mut fmi2Boolean)
+                COMPLETED_INTEGRATOR_STEP |s| {
+                    let event = s.completed_integrator_step()?;
+                    if let Some(out) = unsafe { enterEventMode.as_mut() } {
+                        *out = event.into();
+                    }
+                    if let Some(out) = unsafe { terminateSimulation.as_mut() } {
+                        *out = 0;
+                    }
                     Ok(())
                 };
-                fn fmi2EnterContinuousTimeMode() ENTER_CONTINUOUS_TIME_MODE |s| s.enter_continuous_time_mode();
-                // Pointers that are NULL are not written.
-                fn fmi2CompletedIntegratorStep(_noSetFMUStatePriorToCurrentPoint: fmi2Boolean,
-                    enterEventMode: *mut fmi2Boolean, terminateSimulation: *mut fmi2Boolean)
-                    COMPLETED_INTEGRATOR_STEP |s| {
-                        let event = s.completed_integrator_step()?;
-                        if let Some(out) = unsafe { enterEventMode.as_mut() } {
-                            *out = event.into();
-                        }
-                        if let Some(out) = unsafe { terminateSimulation.as_mut() } {
-                            *out = 0;
-                        }
-                        Ok(())
-                    };
-                fn fmi2GetDerivatives(derivatives: *mut fmi2Real, nx: usize) GET_CONTINUOUS
-                    |s| s.get_derivatives(unsafe { slice_mut(derivatives, nx, "the output array") }?);
-                fn fmi2GetEventIndicators(eventIndicators: *mut fmi2Real, ni: usize) GET_CONTINUOUS
-                    |s| s.get_event_indicators(unsafe { slice_mut(eventIndicators, ni, "the output array") }?);
-                fn fmi2GetContinuousStates(x: *mut fmi2Real, nx: usize) GET_CONTINUOUS
-                    |s| s.get_continuous_states(unsafe { slice_mut(x, nx, "the output array") }?);
-                fn fmi2GetNominalsOfContinuousStates(x_nominal: *mut fmi2Real, nx: usize) GET_CONTINUOUS
-                    |s| s.get_nominals_of_continuous_states(unsafe { slice_mut(x_nominal, nx, "the output array") }?);
-            }
+            fn fmi2GetDerivatives(derivatives: *mut fmi2Real, nx: usize) GET_CONTINUOUS
+                |s| s.get_derivatives(unsafe { slice_mut(derivatives, nx, "the output array") }?);
+            fn fmi2GetEventIndicators(eventIndicators: *mut fmi2Real, ni: usize) GET_CONTINUOUS
+                |s| s.get_event_indicators(unsafe { slice_mut(eventIndicators, ni, "the output array") }?);
+            fn fmi2GetContinuousStates(x: *mut fmi2Real, nx: usize) GET_CONTINUOUS
+                |s| s.get_continuous_states(unsafe { slice_mut(x, nx, "the output array") }?);
+            fn fmi2GetNominalsOfContinuousStates(x_nominal: *mut fmi2Real, nx: usize) GET_CONTINUOUS
+                |s| s.get_nominals_of_continuous_states(unsafe { slice_mut(x_nominal, nx, "the output array") }?);
         }
     };
 }
