@@ -446,7 +446,7 @@ fn rust(c: &Contract, guid: &str) -> String {
     for (i, v) in c.variable.iter().enumerate() {
         writeln!(r, "        (Kind::{}, {}) => Some({i}),", v.ty, v.vr).unwrap();
     }
-    r += "        _ => None,\n    }\n}\n\n/// Looks a variable up by kind and value reference.\npub fn find(kind: Kind, vr: u32) -> Option<&'static Variable> {\n    index(kind, vr).map(|i| &VARIABLES[i])\n}\n";
+    r += "        _ => None,\n    }\n}\n\n/// Looks a variable up by kind and value reference.\npub fn find(kind: Kind, vr: u32) -> Option<&'static Variable> {\n    index(kind, vr).map(|i| &VARIABLES[i])\n}\n\n/// The variable of a kind and value reference, or the importer's error for an unknown one.\npub fn variable(kind: Kind, vr: u32) -> fmi2_shell::FmiResult<&'static Variable> {\n    find(kind, vr).ok_or_else(|| fmi2_shell::contract::unknown(kind, vr))\n}\n";
     r
 }
 

@@ -1,7 +1,7 @@
 //! What the `fmi2*` C exports ([`export_co_simulation!`](crate::export_co_simulation)) share
 //! beyond the guard: fmi2Instantiate and fmi2FreeInstance (no component to guard yet, or any
 //! more), C strings, and the answers of the functions for which this shell's models have no
-//! values (Boolean and String variables, the asynchronous step's statuses).
+//! values (the asynchronous step's statuses).
 #![allow(clippy::missing_safety_doc)]
 
 use crate::component::{Component, slice, slice_mut};
@@ -114,17 +114,6 @@ pub unsafe fn category_names(categories: *const fmi2String, n: usize) -> FmiResu
         .iter()
         .map(|&s| unsafe { text(s) }.unwrap_or("<NULL>").to_string())
         .collect())
-}
-
-/// fmi2Get/SetBoolean and fmi2Get/SetString: the model has no such variables, so any value
-/// reference is unknown.
-pub fn no_variables(kind: &str, vrs: &[fmi2ValueReference]) -> FmiResult {
-    match vrs.first() {
-        None => Ok(()),
-        Some(vr) => Err(FmiError::error(format!(
-            "unknown value reference {vr} for type {kind}: the model has no {kind} variables"
-        ))),
-    }
 }
 
 /// A status kind this FMU has no value for: fmi2Discard, as the standard asks.

@@ -24,6 +24,7 @@ macro_rules! exports {
             #![allow(non_snake_case, clippy::missing_safety_doc)]
             use super::*;
             use $crate::component::{slice, slice_mut};
+            use $crate::contract::no_variables;
             use $crate::export as e;
             use $crate::fmi2::*;
             use $crate::slave::Slave as _;
@@ -84,7 +85,12 @@ macro_rules! export_co_simulation {
                 };
             fn fmi2SetupExperiment(toleranceDefined: fmi2Boolean, tolerance: fmi2Real, startTime: fmi2Real,
                 _stopTimeDefined: fmi2Boolean, _stopTime: fmi2Real)
-                SETUP_EXPERIMENT |s| s.setup_experiment((toleranceDefined != 0).then_some(tolerance), startTime);
+                SETUP_EXPERIMENT |s| {
+                    if !startTime.is_finite() {
+                        return Err(FmiError::error(format!("startTime = {startTime} must be finite")));
+                    }
+                    s.setup_experiment((toleranceDefined != 0).then_some(tolerance), startTime)
+                };
             fn fmi2EnterInitializationMode() ENTER_INITIALIZATION_MODE |s| s.enter_initialization_mode();
             fn fmi2ExitInitializationMode() EXIT_INITIALIZATION_MODE |s| s.exit_initialization_mode();
             fn fmi2Terminate() TERMINATE |s| s.terminate();
@@ -98,17 +104,17 @@ macro_rules! export_co_simulation {
             fn fmi2GetInteger(vr: *const fmi2ValueReference, nvr: usize, value: *mut fmi2Integer)
                 GET |s| s.get_integer(unsafe { slice(vr, nvr, "vr") }?, unsafe { slice_mut(value, nvr, "value") }?);
             fn fmi2GetBoolean(vr: *const fmi2ValueReference, nvr: usize, _value: *mut fmi2Boolean)
-                GET |_| e::no_variables("Boolean", unsafe { slice(vr, nvr, "vr") }?);
+                GET |_| no_variables("Boolean", unsafe { slice(vr, nvr, "vr") }?);
             fn fmi2GetString(vr: *const fmi2ValueReference, nvr: usize, _value: *mut fmi2String)
-                GET |_| e::no_variables("String", unsafe { slice(vr, nvr, "vr") }?);
+                GET |_| no_variables("String", unsafe { slice(vr, nvr, "vr") }?);
             fn fmi2SetReal(vr: *const fmi2ValueReference, nvr: usize, value: *const fmi2Real)
                 SET |s| s.set_real(unsafe { slice(vr, nvr, "vr") }?, unsafe { slice(value, nvr, "value") }?);
             fn fmi2SetInteger(vr: *const fmi2ValueReference, nvr: usize, value: *const fmi2Integer)
                 SET |s| s.set_integer(unsafe { slice(vr, nvr, "vr") }?, unsafe { slice(value, nvr, "value") }?);
             fn fmi2SetBoolean(vr: *const fmi2ValueReference, nvr: usize, _value: *const fmi2Boolean)
-                SET |_| e::no_variables("Boolean", unsafe { slice(vr, nvr, "vr") }?);
+                SET |_| no_variables("Boolean", unsafe { slice(vr, nvr, "vr") }?);
             fn fmi2SetString(vr: *const fmi2ValueReference, nvr: usize, _value: *const fmi2String)
-                SET |_| e::no_variables("String", unsafe { slice(vr, nvr, "vr") }?);
+                SET |_| no_variables("String", unsafe { slice(vr, nvr, "vr") }?);
 
             fn fmi2DoStep(currentCommunicationPoint: fmi2Real, communicationStepSize: fmi2Real,
                 _noSetFMUStatePriorToCurrentPoint: fmi2Boolean)
