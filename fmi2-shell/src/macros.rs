@@ -8,12 +8,26 @@
 //! [`allowed`]: crate::state::allowed
 //! [`guard`]: crate::component::guard
 
+/// `array!(p, n)`: the importer's array `p` of `n` elements as a slice (`array!(mut p, n)`: a
+/// mutable one), or the call's error naming `p` if it is NULL (see
+/// [`slice`](crate::component::slice)).
+#[doc(hidden)]
+#[macro_export]
+macro_rules! array {
+    ($p:ident, $n:expr) => {
+        unsafe { $crate::component::slice($p, $n, stringify!($p)) }?
+    };
+    (mut $p:ident, $n:expr) => {
+        unsafe { $crate::component::slice_mut($p, $n, stringify!($p)) }?
+    };
+}
+
 /// Defines the module `$module` of exports for the slave type `$slave`: the `items` as they
 /// are, then each `fn fmi2Name(args after the component) ALLOWED |slave| body;` as
 /// `fmi2Name(fmi2Component c, args)`, which runs `body` through the guard under the name
 /// "fmi2Name" with the mask `allowed::ALLOWED`. Pointer arguments are the importer's, each
 /// valid for the length the call gives (FMI's contract); the bodies turn them into slices
-/// with [`slice`](crate::component::slice), which refuses a NULL one.
+/// with [`array!`](crate::array), which refuses a NULL one.
 #[doc(hidden)]
 #[macro_export]
 macro_rules! exports {
@@ -23,7 +37,7 @@ macro_rules! exports {
         mod $module {
             #![allow(non_snake_case, clippy::missing_safety_doc)]
             use super::*;
-            use $crate::component::{slice, slice_mut};
+            use $crate::array;
             use $crate::contract::no_variables;
             use $crate::export as e;
             use $crate::fmi2::*;
@@ -49,6 +63,7 @@ macro_rules! export_co_simulation {
     ($slave:ty) => {
         $crate::exports! { mod fmi2_exports for $slave; {
             use ::std::ffi::c_char;
+            use $crate::component::{slice, slice_mut};
             use $crate::fmu_state;
             use $crate::slave::{reset, restore, snapshot};
 
@@ -100,21 +115,21 @@ macro_rules! export_co_simulation {
             };
 
             fn fmi2GetReal(vr: *const fmi2ValueReference, nvr: usize, value: *mut fmi2Real)
-                GET |s| s.get_real(unsafe { slice(vr, nvr, "vr") }?, unsafe { slice_mut(value, nvr, "value") }?);
+                GET |s| s.get_real(array!(vr, nvr), array!(mut value, nvr));
             fn fmi2GetInteger(vr: *const fmi2ValueReference, nvr: usize, value: *mut fmi2Integer)
-                GET |s| s.get_integer(unsafe { slice(vr, nvr, "vr") }?, unsafe { slice_mut(value, nvr, "value") }?);
+                GET |s| s.get_integer(array!(vr, nvr), array!(mut value, nvr));
             fn fmi2GetBoolean(vr: *const fmi2ValueReference, nvr: usize, _value: *mut fmi2Boolean)
-                GET |_| no_variables("Boolean", unsafe { slice(vr, nvr, "vr") }?);
+                GET |_| no_variables("Boolean", array!(vr, nvr));
             fn fmi2GetString(vr: *const fmi2ValueReference, nvr: usize, _value: *mut fmi2String)
-                GET |_| no_variables("String", unsafe { slice(vr, nvr, "vr") }?);
+                GET |_| no_variables("String", array!(vr, nvr));
             fn fmi2SetReal(vr: *const fmi2ValueReference, nvr: usize, value: *const fmi2Real)
-                SET |s| s.set_real(unsafe { slice(vr, nvr, "vr") }?, unsafe { slice(value, nvr, "value") }?);
+                SET |s| s.set_real(array!(vr, nvr), array!(value, nvr));
             fn fmi2SetInteger(vr: *const fmi2ValueReference, nvr: usize, value: *const fmi2Integer)
-                SET |s| s.set_integer(unsafe { slice(vr, nvr, "vr") }?, unsafe { slice(value, nvr, "value") }?);
+                SET |s| s.set_integer(array!(vr, nvr), array!(value, nvr));
             fn fmi2SetBoolean(vr: *const fmi2ValueReference, nvr: usize, _value: *const fmi2Boolean)
-                SET |_| no_variables("Boolean", unsafe { slice(vr, nvr, "vr") }?);
+                SET |_| no_variables("Boolean", array!(vr, nvr));
             fn fmi2SetString(vr: *const fmi2ValueReference, nvr: usize, _value: *const fmi2String)
-                SET |_| no_variables("String", unsafe { slice(vr, nvr, "vr") }?);
+                SET |_| no_variables("String", array!(vr, nvr));
 
             fn fmi2DoStep(currentCommunicationPoint: fmi2Real, communicationStepSize: fmi2Real,
                 _noSetFMUStatePriorToCurrentPoint: fmi2Boolean)
@@ -143,7 +158,7 @@ macro_rules! export_co_simulation {
                 FMU_STATE |_| unsafe { fmu_state::free::<S>(state) };
             fn fmi2SerializedFMUstateSize(state: fmi2FMUstate, size: *mut usize) FMU_STATE |_| {
                 let saved = unsafe { fmu_state::get::<S>(state) }?;
-                unsafe { slice_mut(size, 1, "size") }?[0] = fmu_state::serialize(&saved.slave).len();
+                array!(mut size, 1)[0] = fmu_state::serialize(&saved.slave).len();
                 Ok(())
             };
             fn fmi2SerializeFMUstate(state: fmi2FMUstate, bytes: *mut fmi2Byte, size: usize) FMU_STATE |_| {
@@ -167,26 +182,14 @@ macro_rules! export_co_simulation {
             fn fmi2GetDirectionalDerivative(vUnknown_ref: *const fmi2ValueReference, nUnknown: usize,
                 vKnown_ref: *const fmi2ValueReference, nKnown: usize, dvKnown: *const fmi2Real,
                 dvUnknown: *mut fmi2Real)
-                GET |s| s.directional_derivative(
-                    unsafe { slice(vUnknown_ref, nUnknown, "vUnknown_ref") }?,
-                    unsafe { slice(vKnown_ref, nKnown, "vKnown_ref") }?,
-                    unsafe { slice(dvKnown, nKnown, "dvKnown") }?,
-                    unsafe { slice_mut(dvUnknown, nUnknown, "dvUnknown") }?,
-                );
+                GET |s| s.directional_derivative(array!(vUnknown_ref, nUnknown), array!(vKnown_ref, nKnown),
+                    array!(dvKnown, nKnown), array!(mut dvUnknown, nUnknown));
             fn fmi2SetRealInputDerivatives(vr: *const fmi2ValueReference, nvr: usize,
                 order: *const fmi2Integer, value: *const fmi2Real)
-                SET |s| s.set_input_derivatives(
-                    unsafe { slice(vr, nvr, "vr") }?,
-                    unsafe { slice(order, nvr, "order") }?,
-                    unsafe { slice(value, nvr, "value") }?,
-                );
+                SET |s| s.set_input_derivatives(array!(vr, nvr), array!(order, nvr), array!(value, nvr));
             fn fmi2GetRealOutputDerivatives(vr: *const fmi2ValueReference, nvr: usize,
                 order: *const fmi2Integer, value: *mut fmi2Real)
-                GET |s| s.get_output_derivatives(
-                    unsafe { slice(vr, nvr, "vr") }?,
-                    unsafe { slice(order, nvr, "order") }?,
-                    unsafe { slice_mut(value, nvr, "value") }?,
-                );
+                GET |s| s.get_output_derivatives(array!(vr, nvr), array!(order, nvr), array!(mut value, nvr));
         }
     };
 }
@@ -199,7 +202,7 @@ macro_rules! export_model_exchange {
         $crate::exports! { mod fmi2_model_exchange_exports for $slave; {}
             fn fmi2SetTime(time: fmi2Real) SET_TIME |s| s.set_time(time);
             fn fmi2SetContinuousStates(x: *const fmi2Real, nx: usize)
-                SET_CONTINUOUS_STATES |s| s.set_continuous_states(unsafe { slice(x, nx, "x") }?);
+                SET_CONTINUOUS_STATES |s| s.set_continuous_states(array!(x, nx));
             fn fmi2EnterEventMode() ENTER_EVENT_MODE |s| s.enter_event_mode();
             fn fmi2NewDiscreteStates(info: *mut fmi2EventInfo) NEW_DISCRETE_STATES |s| {
                 let Some(out) = (unsafe { info.as_mut() }) else {
@@ -223,13 +226,13 @@ macro_rules! export_model_exchange {
                     Ok(())
                 };
             fn fmi2GetDerivatives(derivatives: *mut fmi2Real, nx: usize) GET_CONTINUOUS
-                |s| s.get_derivatives(unsafe { slice_mut(derivatives, nx, "the output array") }?);
+                |s| s.get_derivatives(array!(mut derivatives, nx));
             fn fmi2GetEventIndicators(eventIndicators: *mut fmi2Real, ni: usize) GET_CONTINUOUS
-                |s| s.get_event_indicators(unsafe { slice_mut(eventIndicators, ni, "the output array") }?);
+                |s| s.get_event_indicators(array!(mut eventIndicators, ni));
             fn fmi2GetContinuousStates(x: *mut fmi2Real, nx: usize) GET_CONTINUOUS
-                |s| s.get_continuous_states(unsafe { slice_mut(x, nx, "the output array") }?);
+                |s| s.get_continuous_states(array!(mut x, nx));
             fn fmi2GetNominalsOfContinuousStates(x_nominal: *mut fmi2Real, nx: usize) GET_CONTINUOUS
-                |s| s.get_nominals_of_continuous_states(unsafe { slice_mut(x_nominal, nx, "the output array") }?);
+                |s| s.get_nominals_of_continuous_states(array!(mut x_nominal, nx));
         }
     };
 }
