@@ -108,7 +108,12 @@ pub trait Slave: Clone + Serialize + DeserializeOwned {
     /// shell declare maxOutputDerivativeOrder = 1), from [`output_derivative`].
     ///
     /// [`output_derivative`]: Slave::output_derivative
-    fn get_output_derivatives(&mut self, vrs: &[u32], orders: &[i32], out: &mut [f64]) -> FmiResult {
+    fn get_output_derivatives(
+        &mut self,
+        vrs: &[u32],
+        orders: &[i32],
+        out: &mut [f64],
+    ) -> FmiResult {
         for ((vr, order), out) in vrs.iter().zip(orders).zip(out) {
             if *order != 1 {
                 return Err(FmiError::error(format!(
