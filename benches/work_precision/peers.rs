@@ -157,6 +157,20 @@ pub struct Run {
     pub edges: u64,
 }
 
+impl Run {
+    /// An empty run with room for `n` grid points.
+    pub fn with_capacity(n: usize) -> Self {
+        Run {
+            xi: Vec::with_capacity(n),
+            xi_dot: Vec::with_capacity(n),
+            counts: Vec::with_capacity(n),
+            rhs: 0,
+            steps: 0,
+            edges: 0,
+        }
+    }
+}
+
 /// Root of g on [a, b] with g(a), g(b) of opposite signs, to a few ulps (the crate's Illinois
 /// search): the end of the final bracket on a's side, so the root returned never lies past
 /// the crossing.
@@ -250,14 +264,7 @@ pub fn drive<S: Stepper>(
     model.evals.set(0);
     let mut rattle = Rattle::new(model.rattle.dynamics, model.rattle.excitation, y0[XI]);
     model.region.set(rattle.region);
-    let mut run = Run {
-        xi: Vec::with_capacity(grid.len()),
-        xi_dot: Vec::with_capacity(grid.len()),
-        counts: Vec::with_capacity(grid.len()),
-        rhs: 0,
-        steps: 0,
-        edges: 0,
-    };
+    let mut run = Run::with_capacity(grid.len());
     s.restart(model, 0.0, &y0, 0.0)?;
     let (mut t, mut y) = (0.0, y0);
     let mut k = 0;
