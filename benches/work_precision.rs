@@ -236,14 +236,7 @@ fn run_gearrattle(sc: &Scene, rtol: f64) -> Outcome {
     let mut solver = Solver::new(rattle.tolerance(rtol));
     solver.interpolate_ends = true;
     let (mut t, mut y) = (0.0, y0(&p));
-    let mut run = Run {
-        xi: Vec::with_capacity(g.len()),
-        xi_dot: Vec::with_capacity(g.len()),
-        counts: Vec::with_capacity(g.len()),
-        rhs: 0,
-        steps: 0,
-        edges: 0,
-    };
+    let mut run = Run::with_capacity(g.len());
     for &tg in &g {
         if tg > t {
             solver
@@ -390,7 +383,7 @@ fn run_steps(sc: &Scene, rtol: f64, comm: f64) -> Outcome {
     let (every, stride) = sampling(comm);
     let start = cpu_now();
     let mut sim = Simulation::new(&fmu_values(sc), 0.0, 0.0, rtol).map_err(|e| e.message)?;
-    let mut run = empty_run(n / every + 1);
+    let mut run = Run::with_capacity(n / every + 1);
     let record = |run: &mut Run, sim: &Simulation| {
         run.xi.push(sim.real_output(vr::xi).unwrap());
         run.xi_dot.push(sim.real_output(vr::xi_dot).unwrap());
@@ -415,17 +408,6 @@ fn run_steps(sc: &Scene, rtol: f64, comm: f64) -> Outcome {
     run.steps = stats.accepted + stats.rejected;
     run.edges = stats.edges;
     Ok((Sampled { run, stride }, cpu))
-}
-
-fn empty_run(capacity: usize) -> Run {
-    Run {
-        xi: Vec::with_capacity(capacity),
-        xi_dot: Vec::with_capacity(capacity),
-        counts: Vec::with_capacity(capacity),
-        rhs: 0,
-        steps: 0,
-        edges: 0,
-    }
 }
 
 /// Initialises an instance of the FMU for scene `sc` at `rtol` (bench sine, the scene's
@@ -458,7 +440,7 @@ fn run_fmu(import: &Fmi2Import, sc: &Scene, rtol: f64, comm: f64) -> Outcome {
         .map_err(|e| format!("instantiate: {e:?}"))?;
     let start = cpu_now();
     init_fmu(&mut inst, sc, rtol).map_err(fmi)?;
-    let mut run = empty_run(n / every + 1);
+    let mut run = Run::with_capacity(n / every + 1);
     let outs = [vr::xi, vr::xi_dot];
     let counters = [vr::impacts_Fplus, vr::impacts_Fminus];
     let mut x = [0.0; 2];

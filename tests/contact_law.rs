@@ -123,56 +123,20 @@ fn paper_constants_and_the_k_lm_identity() {
 
 #[test]
 fn invalid_parameters_name_themselves() {
+    // The paper's parameters with one changed.
+    let with = |change: fn(&mut GearParams)| {
+        let mut p = GearParams::paper();
+        change(&mut p);
+        p
+    };
     let bad = [
-        (
-            "I_L",
-            GearParams {
-                I_L: 0.0,
-                ..GearParams::paper()
-            },
-        ),
-        (
-            "r_M",
-            GearParams {
-                r_M: -1.0,
-                ..GearParams::paper()
-            },
-        ),
-        (
-            "alpha",
-            GearParams {
-                alpha: 0.9,
-                ..GearParams::paper()
-            },
-        ),
-        (
-            "epsilon",
-            GearParams {
-                epsilon: -1e-9,
-                ..GearParams::paper()
-            },
-        ),
-        (
-            "G",
-            GearParams {
-                G: f64::NAN,
-                ..GearParams::paper()
-            },
-        ),
-        (
-            "C_LM",
-            GearParams {
-                C_LM: -1.0,
-                ..GearParams::paper()
-            },
-        ),
-        (
-            "C",
-            GearParams {
-                C: f64::INFINITY,
-                ..GearParams::paper()
-            },
-        ),
+        ("I_L", with(|p| p.I_L = 0.0)),
+        ("r_M", with(|p| p.r_M = -1.0)),
+        ("alpha", with(|p| p.alpha = 0.9)),
+        ("epsilon", with(|p| p.epsilon = -1e-9)),
+        ("G", with(|p| p.G = f64::NAN)),
+        ("C_LM", with(|p| p.C_LM = -1.0)),
+        ("C", with(|p| p.C = f64::INFINITY)),
     ];
     for (name, p) in bad {
         let e = p.validate().expect_err(name);

@@ -234,7 +234,7 @@ fn reads(slave: &Slave, t: f64) {
 /// One run in drive mode `excitation` (0 inputs, 1 sine, 2 torque) on an instance, from
 /// initialisation to fmi2Terminate.
 fn run(slave: &Slave, excitation: i32) {
-    let (mut reals, _) = s1_start(0.0);
+    let (mut reals, _) = s1_start(30.0, 0.0);
     if excitation == 2 {
         reals.push((vr::tau_in, 1.0));
     }
@@ -305,7 +305,7 @@ fn full_lifecycles_in_every_drive_mode() {
     for steps in 0..3 {
         let other = Slave::new("freed early", false);
         if steps > 0 {
-            other.initialise(1e-6, &s1_start(0.0).0, &[(vr::excitation, 1)]);
+            other.initialise(1e-6, &s1_start(30.0, 0.0).0, &[(vr::excitation, 1)]);
         }
         if steps > 1 {
             ok(&other, "fmi2DoStep", other.step(0.0, 1e-3));

@@ -59,7 +59,7 @@ fn memory_stays_flat_over_instances_and_fmu_states() {
 }
 
 fn instantiate_and_free_100_000_times() {
-    let (reals, integers) = s1_start(0.0);
+    let (reals, integers) = s1_start(30.0, 0.0);
     soak("instantiate/initialise/step/free", 100_000, |k| {
         let slave = Slave::new(&format!("soak{k}"), false);
         slave.initialise(1e-6, &reals, &integers);
@@ -69,7 +69,7 @@ fn instantiate_and_free_100_000_times() {
 
 fn get_set_free_fmu_state_1_000_000_times() {
     let slave = Slave::new("states", false);
-    let (reals, integers) = s1_start(0.0);
+    let (reals, integers) = s1_start(30.0, 0.0);
     slave.initialise(1e-6, &reals, &integers);
     ok(&slave, "fmi2DoStep", slave.step(0.0, 0.01));
     let c = slave.c;

@@ -6,7 +6,6 @@
 mod capi;
 
 use capi::{Line, Slave, s1_start};
-use gear_rattle::contract::vr;
 use std::sync::{Arc, Barrier};
 
 const INSTANCES: usize = 8;
@@ -19,19 +18,12 @@ struct Trace {
     lines: Vec<Line>,
 }
 
-/// Scene k: S1 in sine mode with its own excitation frequency and start in the backlash, so
-/// that instances mixing their states would show.
-fn start(k: usize) -> (Vec<(u32, f64)>, Vec<(u32, i32)>) {
-    let (mut reals, integers) = s1_start(0.04 * k as f64);
-    reals.push((vr::f_exc, 30.0 + 5.0 * k as f64));
-    (reals, integers)
-}
-
-/// Runs scene k on a fresh instance named `name`, with every log category on; `ready` holds
-/// the first step until all threads are there.
+/// Runs scene k on a fresh instance named `name`, with every log category on: S1 in sine mode
+/// with its own excitation frequency and start in the backlash, so that instances mixing
+/// their states would show. `ready` holds the first step until all threads are there.
 fn run(k: usize, name: &str, ready: Option<&Barrier>) -> Trace {
     let slave = Slave::new(name, true);
-    let (reals, integers) = start(k);
+    let (reals, integers) = s1_start(30.0 + 5.0 * k as f64, 0.04 * k as f64);
     slave.initialise(1e-6, &reals, &integers);
     if let Some(b) = ready {
         b.wait();

@@ -30,7 +30,7 @@
 
 use std::cell::Cell;
 
-use gear_rattle::integrator::{Edge, Piecewise};
+use gear_rattle::integrator::{Edge, Piecewise, roots};
 use gear_rattle::physics::{Dynamics, Excitation, GearParams, Region};
 use gear_rattle::rattle::{N, Rattle, State, XI, XI_DOT};
 
@@ -157,44 +157,25 @@ pub struct Run {
     pub edges: u64,
 }
 
-/// Root of g on [a, b] with g(a), g(b) of opposite signs (Illinois): the end of the final
-/// bracket on a's side, so the root returned never lies past the crossing.
-fn illinois(mut g: impl FnMut(f64) -> f64, mut a: f64, mut b: f64) -> f64 {
-    let (mut ga, mut gb) = (g(a), g(b));
-    if ga == 0.0 {
-        return a;
-    }
-    let tol = 4.0 * f64::EPSILON * a.abs().max(b.abs()) + 1e-300;
-    let mut side = 0;
-    for _ in 0..200 {
-        if (b - a).abs() <= tol {
-            break;
-        }
-        let mut c = (a * gb - b * ga) / (gb - ga);
-        if !(c > a.min(b) && c < a.max(b)) {
-            c = 0.5 * (a + b);
-        }
-        let gc = g(c);
-        if gc == 0.0 {
-            return c;
-        }
-        if (gc > 0.0) == (ga > 0.0) {
-            a = c;
-            ga = gc;
-            if side == -1 {
-                gb *= 0.5;
-            }
-            side = -1;
-        } else {
-            b = c;
-            gb = gc;
-            if side == 1 {
-                ga *= 0.5;
-            }
-            side = 1;
+impl Run {
+    /// An empty run with room for `n` grid points.
+    pub fn with_capacity(n: usize) -> Self {
+        Run {
+            xi: Vec::with_capacity(n),
+            xi_dot: Vec::with_capacity(n),
+            counts: Vec::with_capacity(n),
+            rhs: 0,
+            steps: 0,
+            edges: 0,
         }
     }
-    a
+}
+
+/// Root of g on [a, b] with g(a), g(b) of opposite signs, to a few ulps (the crate's Illinois
+/// search): the end of the final bracket on a's side, so the root returned never lies past
+/// the crossing.
+fn illinois(g: impl FnMut(f64) -> f64, a: f64, b: f64) -> f64 {
+    roots::illinois(g, a, b, 4.0 * f64::EPSILON * a.abs().max(b.abs()) + 1e-300)
 }
 
 /// The first exit of ξ from [lo, hi] during the last accepted step, if any. With a turning
@@ -283,14 +264,7 @@ pub fn drive<S: Stepper>(
     model.evals.set(0);
     let mut rattle = Rattle::new(model.rattle.dynamics, model.rattle.excitation, y0[XI]);
     model.region.set(rattle.region);
-    let mut run = Run {
-        xi: Vec::with_capacity(grid.len()),
-        xi_dot: Vec::with_capacity(grid.len()),
-        counts: Vec::with_capacity(grid.len()),
-        rhs: 0,
-        steps: 0,
-        edges: 0,
-    };
+    let mut run = Run::with_capacity(grid.len());
     s.restart(model, 0.0, &y0, 0.0)?;
     let (mut t, mut y) = (0.0, y0);
     let mut k = 0;

@@ -282,23 +282,21 @@ fn xml(c: &Contract, guid: &str) -> String {
             x += " initial=\"exact\"";
         }
         write!(x, ">\n      <{}", v.ty).unwrap();
-        if let Some(s) = &v.start {
-            write!(x, " start=\"{}\"", value(s)).unwrap();
-        }
-        if let Some(u) = &v.unit {
-            write!(x, " unit=\"{}\"", esc(u)).unwrap();
-        }
-        if let Some(u) = &v.display_unit {
-            write!(x, " displayUnit=\"{}\"", esc(u)).unwrap();
-        }
-        if let Some(b) = &v.min {
-            write!(x, " min=\"{}\"", value(b)).unwrap();
-        }
-        if let Some(b) = &v.max {
-            write!(x, " max=\"{}\"", value(b)).unwrap();
-        }
-        if let Some(state) = &v.derivative_of {
-            write!(x, " derivative=\"{}\"", index_of(state)).unwrap();
+        let attributes = [
+            ("start", v.start.as_ref().map(value)),
+            ("unit", v.unit.as_deref().map(esc)),
+            ("displayUnit", v.display_unit.as_deref().map(esc)),
+            ("min", v.min.as_ref().map(value)),
+            ("max", v.max.as_ref().map(value)),
+            (
+                "derivative",
+                v.derivative_of.as_deref().map(|s| index_of(s).to_string()),
+            ),
+        ];
+        for (name, a) in &attributes {
+            if let Some(a) = a {
+                write!(x, " {name}=\"{a}\"").unwrap();
+            }
         }
         x += "/>\n    </ScalarVariable>\n";
     }
@@ -446,7 +444,7 @@ fn rust(c: &Contract, guid: &str) -> String {
     for (i, v) in c.variable.iter().enumerate() {
         writeln!(r, "        (Kind::{}, {}) => Some({i}),", v.ty, v.vr).unwrap();
     }
-    r += "        _ => None,\n    }\n}\n\n/// Looks a variable up by kind and value reference.\npub fn find(kind: Kind, vr: u32) -> Option<&'static Variable> {\n    index(kind, vr).map(|i| &VARIABLES[i])\n}\n";
+    r += "        _ => None,\n    }\n}\n\n/// Looks a variable up by kind and value reference.\npub fn find(kind: Kind, vr: u32) -> Option<&'static Variable> {\n    index(kind, vr).map(|i| &VARIABLES[i])\n}\n\n/// The variable of a kind and value reference, or the importer's error for an unknown one.\npub fn variable(kind: Kind, vr: u32) -> fmi2_shell::FmiResult<&'static Variable> {\n    find(kind, vr).ok_or_else(|| fmi2_shell::contract::unknown(kind, vr))\n}\n";
     r
 }
 

@@ -9,9 +9,9 @@
 //!   magic, version, GUID and a CRC;
 //! - statuses and errors in FMI's terms ([`status`]), and the store of the values set
 //!   ([`values`]);
-//! - the types of the contract ([`contract`]) and, for build scripts, the generator of the
-//!   model description and of the constants from the contract TOML (`build`, feature
-//!   "build").
+//! - the types of the contract and the checks of fmi2Set* against it ([`contract`]) and, for
+//!   build scripts, the generator of the model description and of the constants from the
+//!   contract TOML (`build`, feature "build").
 
 #[cfg(feature = "build")]
 pub mod build;

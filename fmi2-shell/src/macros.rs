@@ -1,27 +1,79 @@
 //! [`export_co_simulation!`](crate::export_co_simulation) and
 //! [`export_model_exchange!`](crate::export_model_exchange): the exported `fmi2*` symbols of a
-//! model's cdylib, each a one-line call of the generic body in [`export`](crate::export).
+//! model's cdylib (a generic function cannot be exported, and the symbols must live in the
+//! library the importer loads). Each function is written once, as in the Reference-FMUs'
+//! `fmi2Functions.c`: its C arguments, the states it may be called in ([`allowed`]), and what
+//! it does with the slave, run through the [`guard`].
+//!
+//! [`allowed`]: crate::state::allowed
+//! [`guard`]: crate::component::guard
+
+/// `array!(p, n)`: the importer's array `p` of `n` elements as a slice (`array!(mut p, n)`: a
+/// mutable one), or the call's error naming `p` if it is NULL (see
+/// [`slice`](crate::component::slice)).
+#[doc(hidden)]
+#[macro_export]
+macro_rules! array {
+    ($p:ident, $n:expr) => {
+        unsafe { $crate::component::slice($p, $n, stringify!($p)) }?
+    };
+    (mut $p:ident, $n:expr) => {
+        unsafe { $crate::component::slice_mut($p, $n, stringify!($p)) }?
+    };
+}
+
+/// Defines the module `$module` of exports for the slave type `$slave`: the `items` as they
+/// are, then each `fn fmi2Name(args after the component) ALLOWED |slave| body;` as
+/// `fmi2Name(fmi2Component c, args)`, which runs `body` through the guard under the name
+/// "fmi2Name" with the mask `allowed::ALLOWED`. Pointer arguments are the importer's, each
+/// valid for the length the call gives (FMI's contract); the bodies turn them into slices
+/// with [`array!`](crate::array), which refuses a NULL one.
+#[doc(hidden)]
+#[macro_export]
+macro_rules! exports {
+    (mod $module:ident for $slave:ty; { $($items:item)* } $(
+        fn $name:ident($($arg:ident: $ty:ty),* $(,)?) $allowed:ident |$s:pat_param| $body:expr;
+    )*) => {
+        mod $module {
+            #![allow(non_snake_case, clippy::missing_safety_doc)]
+            use super::*;
+            use $crate::array;
+            use $crate::contract::no_variables;
+            use $crate::export as e;
+            use $crate::fmi2::*;
+            use $crate::slave::Slave as _;
+            use $crate::status::FmiError;
+            type S = $slave;
+
+            $($items)*
+            $(
+                #[unsafe(no_mangle)]
+                pub unsafe extern "C" fn $name(c: fmi2Component, $($arg: $ty),*) -> fmi2Status {
+                    $crate::component::guard(c, stringify!($name), $crate::state::allowed::$allowed, |$s: &mut S| $body)
+                }
+            )*
+        }
+    };
+}
 
 /// Exports every function of FMI 2.0 Co-Simulation for the slave type `$slave` (importers
 /// such as fmpy load all of them by name). Invoke once, in the model's cdylib crate.
 #[macro_export]
 macro_rules! export_co_simulation {
     ($slave:ty) => {
-        mod fmi2_exports {
-            #![allow(non_snake_case, clippy::missing_safety_doc)]
-            use super::*;
+        $crate::exports! { mod fmi2_exports for $slave; {
             use ::std::ffi::c_char;
-            use $crate::export as e;
-            use $crate::fmi2::*;
-            type S = $slave;
+            use $crate::component::{slice, slice_mut};
+            use $crate::fmu_state;
+            use $crate::slave::{reset, restore, snapshot};
 
             #[unsafe(no_mangle)]
             pub extern "C" fn fmi2GetTypesPlatform() -> *const c_char {
-                e::types_platform()
+                c"default".as_ptr()
             }
             #[unsafe(no_mangle)]
             pub extern "C" fn fmi2GetVersion() -> *const c_char {
-                e::version()
+                c"2.0".as_ptr()
             }
             #[unsafe(no_mangle)]
             pub unsafe extern "C" fn fmi2Instantiate(
@@ -39,292 +91,105 @@ macro_rules! export_co_simulation {
             pub unsafe extern "C" fn fmi2FreeInstance(c: fmi2Component) {
                 unsafe { e::free_instance::<S>(c) }
             }
-            #[unsafe(no_mangle)]
-            pub unsafe extern "C" fn fmi2SetDebugLogging(
-                c: fmi2Component,
-                loggingOn: fmi2Boolean,
-                nCategories: usize,
-                categories: *const fmi2String,
-            ) -> fmi2Status {
-                unsafe { e::set_debug_logging::<S>(c, loggingOn, nCategories, categories) }
             }
-            #[unsafe(no_mangle)]
-            pub extern "C" fn fmi2SetupExperiment(
-                c: fmi2Component,
-                toleranceDefined: fmi2Boolean,
-                tolerance: fmi2Real,
-                startTime: fmi2Real,
-                _stopTimeDefined: fmi2Boolean,
-                _stopTime: fmi2Real,
-            ) -> fmi2Status {
-                e::setup_experiment::<S>(c, toleranceDefined, tolerance, startTime)
-            }
-            #[unsafe(no_mangle)]
-            pub extern "C" fn fmi2EnterInitializationMode(c: fmi2Component) -> fmi2Status {
-                e::enter_initialization_mode::<S>(c)
-            }
-            #[unsafe(no_mangle)]
-            pub extern "C" fn fmi2ExitInitializationMode(c: fmi2Component) -> fmi2Status {
-                e::exit_initialization_mode::<S>(c)
-            }
-            #[unsafe(no_mangle)]
-            pub extern "C" fn fmi2Terminate(c: fmi2Component) -> fmi2Status {
-                e::terminate::<S>(c)
-            }
-            #[unsafe(no_mangle)]
-            pub extern "C" fn fmi2Reset(c: fmi2Component) -> fmi2Status {
-                e::reset_instance::<S>(c)
-            }
-            #[unsafe(no_mangle)]
-            pub unsafe extern "C" fn fmi2GetReal(
-                c: fmi2Component,
-                vr: *const fmi2ValueReference,
-                nvr: usize,
-                value: *mut fmi2Real,
-            ) -> fmi2Status {
-                unsafe { e::get_real::<S>(c, vr, nvr, value) }
-            }
-            #[unsafe(no_mangle)]
-            pub unsafe extern "C" fn fmi2GetInteger(
-                c: fmi2Component,
-                vr: *const fmi2ValueReference,
-                nvr: usize,
-                value: *mut fmi2Integer,
-            ) -> fmi2Status {
-                unsafe { e::get_integer::<S>(c, vr, nvr, value) }
-            }
-            #[unsafe(no_mangle)]
-            pub unsafe extern "C" fn fmi2GetBoolean(
-                c: fmi2Component,
-                vr: *const fmi2ValueReference,
-                nvr: usize,
-                _value: *mut fmi2Boolean,
-            ) -> fmi2Status {
-                unsafe {
-                    e::no_variables::<S>(
-                        c,
-                        "fmi2GetBoolean",
-                        $crate::state::allowed::GET,
-                        "Boolean",
-                        vr,
-                        nvr,
-                    )
+
+            fn fmi2SetDebugLogging(loggingOn: fmi2Boolean, nCategories: usize, categories: *const fmi2String)
+                SET_DEBUG_LOGGING |s| {
+                    let names = unsafe { e::category_names(categories, nCategories) }?;
+                    s.log().set_debug_logging(loggingOn != 0, &names)
+                };
+            fn fmi2SetupExperiment(toleranceDefined: fmi2Boolean, tolerance: fmi2Real, startTime: fmi2Real,
+                _stopTimeDefined: fmi2Boolean, _stopTime: fmi2Real)
+                SETUP_EXPERIMENT |s| {
+                    if !startTime.is_finite() {
+                        return Err(FmiError::error(format!("startTime = {startTime} must be finite")));
+                    }
+                    s.setup_experiment((toleranceDefined != 0).then_some(tolerance), startTime)
+                };
+            fn fmi2EnterInitializationMode() ENTER_INITIALIZATION_MODE |s| s.enter_initialization_mode();
+            fn fmi2ExitInitializationMode() EXIT_INITIALIZATION_MODE |s| s.exit_initialization_mode();
+            fn fmi2Terminate() TERMINATE |s| s.terminate();
+            fn fmi2Reset() RESET |s| {
+                reset(s);
+                Ok(())
+            };
+
+            fn fmi2GetReal(vr: *const fmi2ValueReference, nvr: usize, value: *mut fmi2Real)
+                GET |s| s.get_real(array!(vr, nvr), array!(mut value, nvr));
+            fn fmi2GetInteger(vr: *const fmi2ValueReference, nvr: usize, value: *mut fmi2Integer)
+                GET |s| s.get_integer(array!(vr, nvr), array!(mut value, nvr));
+            fn fmi2GetBoolean(vr: *const fmi2ValueReference, nvr: usize, _value: *mut fmi2Boolean)
+                GET |_| no_variables("Boolean", array!(vr, nvr));
+            fn fmi2GetString(vr: *const fmi2ValueReference, nvr: usize, _value: *mut fmi2String)
+                GET |_| no_variables("String", array!(vr, nvr));
+            fn fmi2SetReal(vr: *const fmi2ValueReference, nvr: usize, value: *const fmi2Real)
+                SET |s| s.set_real(array!(vr, nvr), array!(value, nvr));
+            fn fmi2SetInteger(vr: *const fmi2ValueReference, nvr: usize, value: *const fmi2Integer)
+                SET |s| s.set_integer(array!(vr, nvr), array!(value, nvr));
+            fn fmi2SetBoolean(vr: *const fmi2ValueReference, nvr: usize, _value: *const fmi2Boolean)
+                SET |_| no_variables("Boolean", array!(vr, nvr));
+            fn fmi2SetString(vr: *const fmi2ValueReference, nvr: usize, _value: *const fmi2String)
+                SET |_| no_variables("String", array!(vr, nvr));
+
+            fn fmi2DoStep(currentCommunicationPoint: fmi2Real, communicationStepSize: fmi2Real,
+                _noSetFMUStatePriorToCurrentPoint: fmi2Boolean)
+                DO_STEP |s| s.do_step(currentCommunicationPoint, communicationStepSize);
+            fn fmi2CancelStep() CANCEL_STEP |_| Ok(());
+            fn fmi2GetStatus(kind: fmi2StatusKind, _value: *mut fmi2Status)
+                GET_STATUS |_| e::unavailable(kind);
+            fn fmi2GetRealStatus(kind: fmi2StatusKind, value: *mut fmi2Real) GET_STATUS |s| unsafe {
+                e::status(kind, fmi2StatusKind_fmi2LastSuccessfulTime, value, s.last_successful_time())
+            };
+            fn fmi2GetIntegerStatus(kind: fmi2StatusKind, _value: *mut fmi2Integer)
+                GET_STATUS |_| e::unavailable(kind);
+            // The slave never asks the master to end the simulation.
+            fn fmi2GetBooleanStatus(kind: fmi2StatusKind, value: *mut fmi2Boolean)
+                GET_STATUS |_| unsafe { e::status(kind, fmi2StatusKind_fmi2Terminated, value, 0) };
+            fn fmi2GetStringStatus(kind: fmi2StatusKind, _value: *mut fmi2String)
+                GET_STATUS |_| e::unavailable(kind);
+
+            fn fmi2GetFMUstate(state: *mut fmi2FMUstate)
+                FMU_STATE |s| unsafe { fmu_state::store(state, snapshot(s)) };
+            fn fmi2SetFMUstate(state: fmi2FMUstate) FMU_STATE |s| {
+                restore(s, &unsafe { fmu_state::get::<S>(state) }?.slave);
+                Ok(())
+            };
+            fn fmi2FreeFMUstate(state: *mut fmi2FMUstate)
+                FMU_STATE |_| unsafe { fmu_state::free::<S>(state) };
+            fn fmi2SerializedFMUstateSize(state: fmi2FMUstate, size: *mut usize) FMU_STATE |_| {
+                let saved = unsafe { fmu_state::get::<S>(state) }?;
+                array!(mut size, 1)[0] = fmu_state::serialize(&saved.slave).len();
+                Ok(())
+            };
+            fn fmi2SerializeFMUstate(state: fmi2FMUstate, bytes: *mut fmi2Byte, size: usize) FMU_STATE |_| {
+                let data = fmu_state::serialize(&unsafe { fmu_state::get::<S>(state) }?.slave);
+                if data.len() != size {
+                    return Err(FmiError::error(format!(
+                        "size {size} given, the serialized state has {} bytes (fmi2SerializedFMUstateSize)",
+                        data.len()
+                    )));
                 }
-            }
-            #[unsafe(no_mangle)]
-            pub unsafe extern "C" fn fmi2GetString(
-                c: fmi2Component,
-                vr: *const fmi2ValueReference,
-                nvr: usize,
-                _value: *mut fmi2String,
-            ) -> fmi2Status {
-                unsafe {
-                    e::no_variables::<S>(
-                        c,
-                        "fmi2GetString",
-                        $crate::state::allowed::GET,
-                        "String",
-                        vr,
-                        nvr,
-                    )
-                }
-            }
-            #[unsafe(no_mangle)]
-            pub unsafe extern "C" fn fmi2SetReal(
-                c: fmi2Component,
-                vr: *const fmi2ValueReference,
-                nvr: usize,
-                value: *const fmi2Real,
-            ) -> fmi2Status {
-                unsafe { e::set_real::<S>(c, vr, nvr, value) }
-            }
-            #[unsafe(no_mangle)]
-            pub unsafe extern "C" fn fmi2SetInteger(
-                c: fmi2Component,
-                vr: *const fmi2ValueReference,
-                nvr: usize,
-                value: *const fmi2Integer,
-            ) -> fmi2Status {
-                unsafe { e::set_integer::<S>(c, vr, nvr, value) }
-            }
-            #[unsafe(no_mangle)]
-            pub unsafe extern "C" fn fmi2SetBoolean(
-                c: fmi2Component,
-                vr: *const fmi2ValueReference,
-                nvr: usize,
-                _value: *const fmi2Boolean,
-            ) -> fmi2Status {
-                unsafe {
-                    e::no_variables::<S>(
-                        c,
-                        "fmi2SetBoolean",
-                        $crate::state::allowed::SET,
-                        "Boolean",
-                        vr,
-                        nvr,
-                    )
-                }
-            }
-            #[unsafe(no_mangle)]
-            pub unsafe extern "C" fn fmi2SetString(
-                c: fmi2Component,
-                vr: *const fmi2ValueReference,
-                nvr: usize,
-                _value: *const fmi2String,
-            ) -> fmi2Status {
-                unsafe {
-                    e::no_variables::<S>(
-                        c,
-                        "fmi2SetString",
-                        $crate::state::allowed::SET,
-                        "String",
-                        vr,
-                        nvr,
-                    )
-                }
-            }
-            #[unsafe(no_mangle)]
-            pub extern "C" fn fmi2DoStep(
-                c: fmi2Component,
-                currentCommunicationPoint: fmi2Real,
-                communicationStepSize: fmi2Real,
-                _noSetFMUStatePriorToCurrentPoint: fmi2Boolean,
-            ) -> fmi2Status {
-                e::do_step::<S>(c, currentCommunicationPoint, communicationStepSize)
-            }
-            #[unsafe(no_mangle)]
-            pub extern "C" fn fmi2CancelStep(c: fmi2Component) -> fmi2Status {
-                e::cancel_step::<S>(c)
-            }
-            #[unsafe(no_mangle)]
-            pub extern "C" fn fmi2GetStatus(
-                c: fmi2Component,
-                s: fmi2StatusKind,
-                _value: *mut fmi2Status,
-            ) -> fmi2Status {
-                e::get_status::<S>(c, "fmi2GetStatus", s)
-            }
-            #[unsafe(no_mangle)]
-            pub unsafe extern "C" fn fmi2GetRealStatus(
-                c: fmi2Component,
-                s: fmi2StatusKind,
-                value: *mut fmi2Real,
-            ) -> fmi2Status {
-                unsafe { e::get_real_status::<S>(c, s, value) }
-            }
-            #[unsafe(no_mangle)]
-            pub extern "C" fn fmi2GetIntegerStatus(
-                c: fmi2Component,
-                s: fmi2StatusKind,
-                _value: *mut fmi2Integer,
-            ) -> fmi2Status {
-                e::get_status::<S>(c, "fmi2GetIntegerStatus", s)
-            }
-            #[unsafe(no_mangle)]
-            pub unsafe extern "C" fn fmi2GetBooleanStatus(
-                c: fmi2Component,
-                s: fmi2StatusKind,
-                value: *mut fmi2Boolean,
-            ) -> fmi2Status {
-                unsafe { e::get_boolean_status::<S>(c, s, value) }
-            }
-            #[unsafe(no_mangle)]
-            pub extern "C" fn fmi2GetStringStatus(
-                c: fmi2Component,
-                s: fmi2StatusKind,
-                _value: *mut fmi2String,
-            ) -> fmi2Status {
-                e::get_status::<S>(c, "fmi2GetStringStatus", s)
-            }
-            #[unsafe(no_mangle)]
-            pub unsafe extern "C" fn fmi2GetFMUstate(
-                c: fmi2Component,
-                state: *mut fmi2FMUstate,
-            ) -> fmi2Status {
-                unsafe { e::get_fmu_state::<S>(c, state) }
-            }
-            #[unsafe(no_mangle)]
-            pub unsafe extern "C" fn fmi2SetFMUstate(
-                c: fmi2Component,
-                state: fmi2FMUstate,
-            ) -> fmi2Status {
-                unsafe { e::set_fmu_state::<S>(c, state) }
-            }
-            #[unsafe(no_mangle)]
-            pub unsafe extern "C" fn fmi2FreeFMUstate(
-                c: fmi2Component,
-                state: *mut fmi2FMUstate,
-            ) -> fmi2Status {
-                unsafe { e::free_fmu_state::<S>(c, state) }
-            }
-            #[unsafe(no_mangle)]
-            pub unsafe extern "C" fn fmi2SerializedFMUstateSize(
-                c: fmi2Component,
-                state: fmi2FMUstate,
-                size: *mut usize,
-            ) -> fmi2Status {
-                unsafe { e::serialized_fmu_state_size::<S>(c, state, size) }
-            }
-            #[unsafe(no_mangle)]
-            pub unsafe extern "C" fn fmi2SerializeFMUstate(
-                c: fmi2Component,
-                state: fmi2FMUstate,
-                bytes: *mut fmi2Byte,
-                size: usize,
-            ) -> fmi2Status {
-                unsafe { e::serialize_fmu_state::<S>(c, state, bytes, size) }
-            }
-            #[unsafe(no_mangle)]
-            pub unsafe extern "C" fn fmi2DeSerializeFMUstate(
-                c: fmi2Component,
-                bytes: *const fmi2Byte,
-                size: usize,
-                state: *mut fmi2FMUstate,
-            ) -> fmi2Status {
-                unsafe { e::deserialize_fmu_state::<S>(c, bytes, size, state) }
-            }
-            #[unsafe(no_mangle)]
-            pub unsafe extern "C" fn fmi2GetDirectionalDerivative(
-                c: fmi2Component,
-                vUnknown_ref: *const fmi2ValueReference,
-                nUnknown: usize,
-                vKnown_ref: *const fmi2ValueReference,
-                nKnown: usize,
-                dvKnown: *const fmi2Real,
-                dvUnknown: *mut fmi2Real,
-            ) -> fmi2Status {
-                unsafe {
-                    e::get_directional_derivative::<S>(
-                        c,
-                        vUnknown_ref,
-                        nUnknown,
-                        vKnown_ref,
-                        nKnown,
-                        dvKnown,
-                        dvUnknown,
-                    )
-                }
-            }
-            #[unsafe(no_mangle)]
-            pub unsafe extern "C" fn fmi2SetRealInputDerivatives(
-                c: fmi2Component,
-                vr: *const fmi2ValueReference,
-                nvr: usize,
-                order: *const fmi2Integer,
-                value: *const fmi2Real,
-            ) -> fmi2Status {
-                unsafe { e::set_real_input_derivatives::<S>(c, vr, nvr, order, value) }
-            }
-            #[unsafe(no_mangle)]
-            pub unsafe extern "C" fn fmi2GetRealOutputDerivatives(
-                c: fmi2Component,
-                vr: *const fmi2ValueReference,
-                nvr: usize,
-                order: *const fmi2Integer,
-                value: *mut fmi2Real,
-            ) -> fmi2Status {
-                unsafe { e::get_real_output_derivatives::<S>(c, vr, nvr, order, value) }
-            }
+                unsafe { slice_mut(bytes as *mut u8, size, "serializedState") }?.copy_from_slice(&data);
+                Ok(())
+            };
+            fn fmi2DeSerializeFMUstate(bytes: *const fmi2Byte, size: usize, state: *mut fmi2FMUstate)
+                FMU_STATE |_| {
+                    let data = unsafe { slice(bytes as *const u8, size, "serializedState") }?;
+                    let slave = fmu_state::deserialize::<S>(data)?;
+                    unsafe { fmu_state::store(state, slave) }
+                };
+
+            fn fmi2GetDirectionalDerivative(vUnknown_ref: *const fmi2ValueReference, nUnknown: usize,
+                vKnown_ref: *const fmi2ValueReference, nKnown: usize, dvKnown: *const fmi2Real,
+                dvUnknown: *mut fmi2Real)
+                GET |s| s.directional_derivative(array!(vUnknown_ref, nUnknown), array!(vKnown_ref, nKnown),
+                    array!(dvKnown, nKnown), array!(mut dvUnknown, nUnknown));
+            fn fmi2SetRealInputDerivatives(vr: *const fmi2ValueReference, nvr: usize,
+                order: *const fmi2Integer, value: *const fmi2Real)
+                SET |s| s.set_input_derivatives(array!(vr, nvr), array!(order, nvr), array!(value, nvr));
+            fn fmi2GetRealOutputDerivatives(vr: *const fmi2ValueReference, nvr: usize,
+                order: *const fmi2Integer, value: *mut fmi2Real)
+                GET |s| s.get_output_derivatives(array!(vr, nvr), array!(order, nvr), array!(mut value, nvr));
         }
     };
 }
@@ -334,108 +199,40 @@ macro_rules! export_co_simulation {
 #[macro_export]
 macro_rules! export_model_exchange {
     ($slave:ty) => {
-        mod fmi2_model_exchange_exports {
-            #![allow(non_snake_case, clippy::missing_safety_doc)]
-            use super::*;
-            use $crate::export as e;
-            use $crate::fmi2::*;
-            use $crate::slave::Slave as _;
-            type S = $slave;
-
-            #[unsafe(no_mangle)]
-            pub extern "C" fn fmi2SetTime(c: fmi2Component, time: fmi2Real) -> fmi2Status {
-                e::set_time::<S>(c, time)
-            }
-            #[unsafe(no_mangle)]
-            pub unsafe extern "C" fn fmi2SetContinuousStates(
-                c: fmi2Component,
-                x: *const fmi2Real,
-                nx: usize,
-            ) -> fmi2Status {
-                unsafe { e::set_continuous_states::<S>(c, x, nx) }
-            }
-            #[unsafe(no_mangle)]
-            pub extern "C" fn fmi2EnterEventMode(c: fmi2Component) -> fmi2Status {
-                e::enter_event_mode::<S>(c)
-            }
-            #[unsafe(no_mangle)]
-            pub unsafe extern "C" fn fmi2NewDiscreteStates(
-                c: fmi2Component,
-                info: *mut fmi2EventInfo,
-            ) -> fmi2Status {
-                unsafe { e::new_discrete_states::<S>(c, info) }
-            }
-            #[unsafe(no_mangle)]
-            pub extern "C" fn fmi2EnterContinuousTimeMode(c: fmi2Component) -> fmi2Status {
-                e::enter_continuous_time_mode::<S>(c)
-            }
-            #[unsafe(no_mangle)]
-            pub unsafe extern "C" fn fmi2CompletedIntegratorStep(
-                c: fmi2Component,
-                _noSetFMUStatePriorToCurrentPoint: fmi2Boolean,
-                enterEventMode: *mut fmi2Boolean,
-                terminateSimulation: *mut fmi2Boolean,
-            ) -> fmi2Status {
-                unsafe { e::completed_integrator_step::<S>(c, enterEventMode, terminateSimulation) }
-            }
-            #[unsafe(no_mangle)]
-            pub unsafe extern "C" fn fmi2GetDerivatives(
-                c: fmi2Component,
-                derivatives: *mut fmi2Real,
-                nx: usize,
-            ) -> fmi2Status {
-                unsafe {
-                    e::get_vector::<S>(c, "fmi2GetDerivatives", derivatives, nx, S::get_derivatives)
-                }
-            }
-            #[unsafe(no_mangle)]
-            pub unsafe extern "C" fn fmi2GetEventIndicators(
-                c: fmi2Component,
-                eventIndicators: *mut fmi2Real,
-                ni: usize,
-            ) -> fmi2Status {
-                unsafe {
-                    e::get_vector::<S>(
-                        c,
-                        "fmi2GetEventIndicators",
-                        eventIndicators,
-                        ni,
-                        S::get_event_indicators,
-                    )
-                }
-            }
-            #[unsafe(no_mangle)]
-            pub unsafe extern "C" fn fmi2GetContinuousStates(
-                c: fmi2Component,
-                x: *mut fmi2Real,
-                nx: usize,
-            ) -> fmi2Status {
-                unsafe {
-                    e::get_vector::<S>(
-                        c,
-                        "fmi2GetContinuousStates",
-                        x,
-                        nx,
-                        S::get_continuous_states,
-                    )
-                }
-            }
-            #[unsafe(no_mangle)]
-            pub unsafe extern "C" fn fmi2GetNominalsOfContinuousStates(
-                c: fmi2Component,
-                x_nominal: *mut fmi2Real,
-                nx: usize,
-            ) -> fmi2Status {
-                unsafe {
-                    e::get_vector::<S>(
-                        c,
-                        "fmi2GetNominalsOfContinuousStates",
-                        x_nominal,
-                        nx,
-                        S::get_nominals_of_continuous_states,
-                    )
-                }
-            }
+        $crate::exports! { mod fmi2_model_exchange_exports for $slave; {}
+            fn fmi2SetTime(time: fmi2Real) SET_TIME |s| s.set_time(time);
+            fn fmi2SetContinuousStates(x: *const fmi2Real, nx: usize)
+                SET_CONTINUOUS_STATES |s| s.set_continuous_states(array!(x, nx));
+            fn fmi2EnterEventMode() ENTER_EVENT_MODE |s| s.enter_event_mode();
+            fn fmi2NewDiscreteStates(info: *mut fmi2EventInfo) NEW_DISCRETE_STATES |s| {
+                let Some(out) = (unsafe { info.as_mut() }) else {
+                    return Err(FmiError::error("fmi2EventInfo is NULL"));
+                };
+                e::event_info(s.new_discrete_states()?, out);
+                Ok(())
+            };
+            fn fmi2EnterContinuousTimeMode() ENTER_CONTINUOUS_TIME_MODE |s| s.enter_continuous_time_mode();
+            // Pointers that are NULL are not written.
+            fn fmi2CompletedIntegratorStep(_noSetFMUStatePriorToCurrentPoint: fmi2Boolean,
+                enterEventMode: *mut fmi2Boolean, terminateSimulation: *mut fmi2Boolean)
+                COMPLETED_INTEGRATOR_STEP |s| {
+                    let event = s.completed_integrator_step()?;
+                    if let Some(out) = unsafe { enterEventMode.as_mut() } {
+                        *out = event.into();
+                    }
+                    if let Some(out) = unsafe { terminateSimulation.as_mut() } {
+                        *out = 0;
+                    }
+                    Ok(())
+                };
+            fn fmi2GetDerivatives(derivatives: *mut fmi2Real, nx: usize) GET_CONTINUOUS
+                |s| s.get_derivatives(array!(mut derivatives, nx));
+            fn fmi2GetEventIndicators(eventIndicators: *mut fmi2Real, ni: usize) GET_CONTINUOUS
+                |s| s.get_event_indicators(array!(mut eventIndicators, ni));
+            fn fmi2GetContinuousStates(x: *mut fmi2Real, nx: usize) GET_CONTINUOUS
+                |s| s.get_continuous_states(array!(mut x, nx));
+            fn fmi2GetNominalsOfContinuousStates(x_nominal: *mut fmi2Real, nx: usize) GET_CONTINUOUS
+                |s| s.get_nominals_of_continuous_states(array!(mut x_nominal, nx));
         }
     };
 }

@@ -63,10 +63,20 @@ pub trait Slave: Clone + Serialize + DeserializeOwned {
     /// Sets the state: the shell moves a slave into [`FmiState::Error`] after a panic.
     fn set_state(&mut self, state: FmiState);
 
+    /// fmi2SetupExperiment, with a finite start time (the shell checks it).
     fn setup_experiment(&mut self, tolerance: Option<f64>, start_time: f64) -> FmiResult;
-    fn enter_initialization_mode(&mut self) -> FmiResult;
+
+    fn enter_initialization_mode(&mut self) -> FmiResult {
+        self.set_state(FmiState::InitializationMode);
+        Ok(())
+    }
+
     fn exit_initialization_mode(&mut self) -> FmiResult;
-    fn terminate(&mut self) -> FmiResult;
+
+    fn terminate(&mut self) -> FmiResult {
+        self.set_state(FmiState::Terminated);
+        Ok(())
+    }
 
     fn get_real(&mut self, vrs: &[u32], out: &mut [f64]) -> FmiResult;
     fn get_integer(&mut self, vrs: &[u32], out: &mut [i32]) -> FmiResult;
@@ -94,13 +104,29 @@ pub trait Slave: Clone + Serialize + DeserializeOwned {
         Err(unsupported("fmi2SetRealInputDerivatives"))
     }
 
-    /// fmi2GetRealOutputDerivatives (maxOutputDerivativeOrder).
+    /// fmi2GetRealOutputDerivatives: the first derivative of each output (the models of this
+    /// shell declare maxOutputDerivativeOrder = 1), from [`output_derivative`].
+    ///
+    /// [`output_derivative`]: Slave::output_derivative
     fn get_output_derivatives(
         &mut self,
-        _vrs: &[u32],
-        _orders: &[i32],
-        _out: &mut [f64],
+        vrs: &[u32],
+        orders: &[i32],
+        out: &mut [f64],
     ) -> FmiResult {
+        for ((vr, order), out) in vrs.iter().zip(orders).zip(out) {
+            if *order != 1 {
+                return Err(FmiError::error(format!(
+                    "derivative of order {order} of value reference {vr} refused: maxOutputDerivativeOrder is 1"
+                )));
+            }
+            *out = self.output_derivative(*vr)?;
+        }
+        Ok(())
+    }
+
+    /// The first derivative of the output `vr` now.
+    fn output_derivative(&mut self, _vr: u32) -> FmiResult<f64> {
         Err(unsupported("fmi2GetRealOutputDerivatives"))
     }
 

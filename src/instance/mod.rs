@@ -92,41 +92,16 @@ impl Instance {
         ))
     }
 
-    fn variable(kind: Kind, vr: u32) -> FmiResult<&'static contract::Variable> {
-        contract::find(kind, vr).ok_or_else(|| {
-            FmiError::error(format!("unknown value reference {vr} for type {kind:?}"))
-        })
-    }
-
     /// A Real variable's value by its contract entry (a parameter, an input, or an output of
     /// the simulation built from the values so far).
     fn real_value(&mut self, vr: u32) -> FmiResult<f64> {
-        Ok(match Self::variable(Kind::Real, vr)?.causality {
+        Ok(match contract::variable(Kind::Real, vr)?.causality {
             Causality::Output | Causality::Local => self
                 .current()?
                 .real_output(vr)
                 .expect("every computed Real variable of the contract is computed"),
             _ => self.values.real(vr),
         })
-    }
-
-    /// Checks that `var` may be set now.
-    fn settable(&self, var: &contract::Variable) -> FmiResult {
-        match var.causality {
-            Causality::Output => Err(FmiError::error(format!(
-                "{} is an output: it cannot be set",
-                var.name
-            ))),
-            Causality::Local => Err(FmiError::error(format!(
-                "{} is computed by the FMU: it cannot be set",
-                var.name
-            ))),
-            Causality::Parameter if self.state.is_initialised() => Err(FmiError::error(format!(
-                "{} is a fixed parameter: set it before fmi2ExitInitializationMode",
-                var.name
-            ))),
-            _ => Ok(()),
-        }
     }
 
     /// After new values: rebuild the initial state during initialisation, or hand the main
@@ -345,11 +320,6 @@ impl Slave for Instance {
     }
 
     fn setup_experiment(&mut self, tolerance: Option<f64>, start_time: f64) -> FmiResult {
-        if !start_time.is_finite() {
-            return Err(FmiError::error(format!(
-                "startTime = {start_time} must be finite"
-            )));
-        }
         if let Some(tol) = tolerance
             && !(tol > 0.0 && tol < 1.0)
         {
@@ -381,11 +351,6 @@ impl Slave for Instance {
         Ok(())
     }
 
-    fn terminate(&mut self) -> FmiResult {
-        self.state = FmiState::Terminated;
-        Ok(())
-    }
-
     fn get_real(&mut self, vrs: &[u32], out: &mut [f64]) -> FmiResult {
         for (vr, out) in vrs.iter().zip(out) {
             // An output of the running simulation first: what a master reads after each step.
@@ -402,7 +367,7 @@ impl Slave for Instance {
 
     fn get_integer(&mut self, vrs: &[u32], out: &mut [i32]) -> FmiResult {
         for (vr, out) in vrs.iter().zip(out) {
-            let var = Self::variable(Kind::Integer, *vr)?;
+            let var = contract::variable(Kind::Integer, *vr)?;
             let value = match var.causality {
                 Causality::Output => self
                     .current()?
@@ -419,14 +384,7 @@ impl Slave for Instance {
     /// changes nothing.
     fn set_real(&mut self, vrs: &[u32], values: &[f64]) -> FmiResult {
         for (vr, value) in vrs.iter().zip(values) {
-            let var = Self::variable(Kind::Real, *vr)?;
-            self.settable(var)?;
-            if !value.is_finite() {
-                return Err(FmiError::error(format!(
-                    "{} = {value} refused: values must be finite",
-                    var.name
-                )));
-            }
+            contract::variable(Kind::Real, *vr)?.settable_to(self.state, *value)?;
         }
         let mut shaft_changed = false;
         for (vr, value) in vrs.iter().zip(values) {
@@ -441,8 +399,7 @@ impl Slave for Instance {
 
     fn set_integer(&mut self, vrs: &[u32], values: &[i32]) -> FmiResult {
         for vr in vrs {
-            let var = Self::variable(Kind::Integer, *vr)?;
-            self.settable(var)?;
+            contract::variable(Kind::Integer, *vr)?.settable(self.state)?;
         }
         for (vr, value) in vrs.iter().zip(values) {
             self.values.set_integer(*vr, *value as i64);
@@ -540,28 +497,17 @@ impl Slave for Instance {
     }
 
     /// fmi2GetRealOutputDerivatives (order 1).
-    fn get_output_derivatives(
-        &mut self,
-        vrs: &[u32],
-        orders: &[i32],
-        out: &mut [f64],
-    ) -> FmiResult {
-        let sim = self.current()?;
-        for ((vr, order), out) in vrs.iter().zip(orders).zip(out) {
-            let var = Self::variable(Kind::Real, *vr)?;
-            *out = match (order, sim.real_output_derivative(*vr)) {
-                (1, Some(d)) if d.is_finite() => d,
-                (1, Some(d)) => return Err(Self::not_finite(*vr, d)),
-                _ => {
-                    return Err(FmiError::error(format!(
-                        "no derivative of order {order} for {}: order 1 is given for {}",
-                        var.name,
-                        contract::with_derivative().collect::<Vec<_>>().join(", ")
-                    )));
-                }
-            };
+    fn output_derivative(&mut self, vr: u32) -> FmiResult<f64> {
+        let var = contract::variable(Kind::Real, vr)?;
+        match self.current()?.real_output_derivative(vr) {
+            Some(d) if d.is_finite() => Ok(d),
+            Some(d) => Err(Self::not_finite(vr, d)),
+            None => Err(FmiError::error(format!(
+                "no derivative for {}: order 1 is given for {}",
+                var.name,
+                contract::with_derivative().collect::<Vec<_>>().join(", ")
+            ))),
         }
-        Ok(())
     }
 
     /// fmi2GetDirectionalDerivative: dv_unknown = J · dv_known with J = ∂outputs/∂inputs.
@@ -573,7 +519,7 @@ impl Slave for Instance {
         dv_unknown: &mut [f64],
     ) -> FmiResult {
         for k in knowns {
-            let var = Self::variable(Kind::Real, *k)?;
+            let var = contract::variable(Kind::Real, *k)?;
             if var.causality != Causality::Input {
                 return Err(FmiError::error(format!(
                     "{} is not an input: directional derivatives are taken with respect to theta_M, omega_M, alpha_M, tau_in",
@@ -588,7 +534,7 @@ impl Slave for Instance {
         }
         let sim = self.current()?;
         for (u, out) in unknowns.iter().zip(dv_unknown) {
-            let var = Self::variable(Kind::Real, *u)?;
+            let var = contract::variable(Kind::Real, *u)?;
             if var.causality != Causality::Output {
                 return Err(FmiError::error(format!(
                     "{} is not an output: directional derivatives are of outputs",

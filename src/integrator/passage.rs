@@ -96,26 +96,17 @@ impl<const N: usize> Passage<N> {
         Some(evals)
     }
 
-    /// The state at t_end ≤ t_clear, handed out and remembered; returns the number of
-    /// evaluations of the exact solution it took (none at t_clear itself), None if the
-    /// system's piece has no closed form.
-    pub fn serve<S: Piecewise<N>>(
-        &mut self,
-        sys: &mut S,
-        t: &mut f64,
-        y: &mut [f64; N],
-        t_end: f64,
-    ) -> Option<u64> {
-        let evals = if t_end == self.t_clear {
-            *y = self.y_clear;
-            0
+    /// The state at t_end ≤ t_clear, remembered as handed out, and the number of evaluations
+    /// of the exact solution it took (none at t_clear itself); None if the system's piece has
+    /// no closed form.
+    pub fn serve<S: Piecewise<N>>(&mut self, sys: &mut S, t_end: f64) -> Option<([f64; N], u64)> {
+        let (y, evals) = if t_end == self.t_clear {
+            (self.y_clear, 0)
         } else {
-            *y = sys.exact(self.t0, &self.y0)?.at(t_end);
-            1
+            (sys.exact(self.t0, &self.y0)?.at(t_end), 1)
         };
-        *t = t_end;
-        self.left_off = LeftOff::at(t_end, y);
-        Some(evals)
+        self.left_off = LeftOff::at(t_end, &y);
+        Some((y, evals))
     }
 }
 

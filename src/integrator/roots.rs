@@ -3,7 +3,7 @@
 
 /// Finds θ in [a, b] with f(θ) = 0, given f(a) ≥ 0 > f(b) or f(a) ≤ 0 < f(b). Returns the
 /// end of the final bracket on the side of `a`, so the answer never lies past the crossing.
-pub fn illinois(f: impl Fn(f64) -> f64, mut a: f64, mut b: f64, tol: f64) -> f64 {
+pub fn illinois(mut f: impl FnMut(f64) -> f64, mut a: f64, mut b: f64, tol: f64) -> f64 {
     let (mut fa, mut fb) = (f(a), f(b));
     if fa == 0.0 {
         return a;

@@ -185,11 +185,11 @@ impl<const N: usize> Ahead<N> {
         self.t0 + self.h
     }
 
-    /// (t, y) at t_end inside the step, handed out and remembered.
-    fn serve(&mut self, t: &mut f64, y: &mut [f64; N], t_end: f64) {
-        *y = self.dense.at((t_end - self.t0) / self.h);
-        *t = t_end;
-        self.left_off = LeftOff::at(t_end, y);
+    /// The state at t_end inside the step, remembered as handed out.
+    fn serve(&mut self, t_end: f64) -> [f64; N] {
+        let y = self.dense.at((t_end - self.t0) / self.h);
+        self.left_off = LeftOff::at(t_end, &y);
+        y
     }
 }
 
@@ -274,20 +274,21 @@ impl<const N: usize> Solver<N> {
         y: &mut [f64; N],
         t_end: f64,
     ) -> bool {
-        match &mut self.kept {
+        let served = match &mut self.kept {
             Some(Kept::Step(a)) if a.left_off.continued_by(*t, y) && t_end <= a.t1() => {
-                a.serve(t, y, t_end);
-                true
+                Some((a.serve(t_end), 0))
             }
             Some(Kept::Passage(p)) if p.continued_by(*t, y) && t_end <= p.t_clear => {
-                let Some(evals) = p.serve(sys, t, y, t_end) else {
-                    return false;
-                };
-                self.stats.exact_evals += evals;
-                true
+                p.serve(sys, t_end)
             }
-            _ => false,
-        }
+            _ => None,
+        };
+        let Some((y_end, evals)) = served else {
+            return false;
+        };
+        (*t, *y) = (t_end, y_end);
+        self.stats.exact_evals += evals;
+        true
     }
 
     /// Advances (t, y) to `t_end` exactly.
@@ -405,7 +406,10 @@ impl<const N: usize> Solver<N> {
                 Ok(Some(Flow::Go))
             }
             _ => {
-                self.stats.exact_evals += passage.serve(sys, t, y, t_end).unwrap_or(0);
+                if let Some((y_end, evals)) = passage.serve(sys, t_end) {
+                    (*t, *y) = (t_end, y_end);
+                    self.stats.exact_evals += evals;
+                }
                 self.kept = Some(Kept::Passage(passage));
                 Ok(Some(Flow::Done))
             }
@@ -531,7 +535,7 @@ impl<const N: usize> Solver<N> {
             edge,
             left_off: LeftOff::at(t_end, y),
         };
-        ahead.serve(t, y, t_end);
+        (*t, *y) = (t_end, ahead.serve(t_end));
         self.kept = Some(Kept::Step(ahead));
     }
 }

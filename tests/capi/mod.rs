@@ -379,12 +379,16 @@ impl Drop for Slave {
     }
 }
 
-/// Start values of the paper's bench scene S1 in sine mode (MODEL.md §5), with ξ(0) moved by
-/// `shift` × G so that scenes differ from one another.
-pub fn s1_start(shift: f64) -> (Vec<(u32, f64)>, Vec<(u32, i32)>) {
+/// Start values: (value reference, value) of Real and of Integer variables.
+pub type Start = (Vec<(u32, f64)>, Vec<(u32, i32)>);
+
+/// Start values of the paper's bench scene S1 in sine mode (MODEL.md §5; f_exc = 30 Hz), or of
+/// a scene like it at another excitation frequency, with ξ(0) moved by `shift` × G, so that
+/// scenes differ from one another.
+pub fn s1_start(f_exc: f64, shift: f64) -> Start {
     (
         vec![
-            (vr::f_exc, 30.0),
+            (vr::f_exc, f_exc),
             (vr::A_rms, 300.0),
             (vr::gap_start, 0.5 + shift),
         ],

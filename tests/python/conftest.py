@@ -59,6 +59,32 @@ def vrs(model_description) -> dict:
     return {v.name: v.valueReference for v in model_description.modelVariables}
 
 
+@pytest.fixture
+def slave(unzipdir, model_description, vrs):
+    """slave(name, start_time=0.0, tolerance=None, **start) -> an fmpy FMU2Slave, instantiated
+    and initialised with the start values `start` (an int sets an Integer), freed after the
+    test."""
+    from fmpy.fmi2 import FMU2Slave
+
+    made = []
+
+    def make(name, start_time=0.0, tolerance=None, **start):
+        fmu = FMU2Slave(guid=model_description.guid, unzipDirectory=unzipdir,
+                        modelIdentifier=model_description.coSimulation.modelIdentifier, instanceName=name)
+        fmu.instantiate()
+        made.append(fmu)
+        fmu.setupExperiment(tolerance=tolerance, startTime=start_time)
+        fmu.enterInitializationMode()
+        for n, v in start.items():
+            (fmu.setInteger if isinstance(v, int) else fmu.setReal)([vrs[n]], [v])
+        fmu.exitInitializationMode()
+        return fmu
+
+    yield make
+    for fmu in made:
+        fmu.freeInstance()
+
+
 def main_shaft_input(scene: str, t_end: float, dt: float = 1e-4, fields=("theta_M", "omega_M", "alpha_M"), **overrides):
     """Structured input array for fmpy: the analytic sine motion of the main shaft (§5)."""
     p = R.params(scene, **overrides)

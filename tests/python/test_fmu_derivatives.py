@@ -3,9 +3,6 @@ against finite differences and against the same motion given as plain inputs."""
 
 import numpy as np
 import reference as R
-from fmpy.fmi2 import FMU2Slave
-
-from test_fmu_state import make
 
 
 def shaft(t):
@@ -29,29 +26,23 @@ def drive(s, vrs, n, h, with_derivatives):
     return np.array(xi)
 
 
-def start_inputs(unzipdir, md, vrs, name):
-    s = FMU2Slave(guid=md.guid, unzipDirectory=unzipdir, modelIdentifier=md.coSimulation.modelIdentifier, instanceName=name)
-    s.instantiate()
-    s.setupExperiment(startTime=0.0)
-    s.enterInitializationMode()
-    th, om, al = shaft(0.0)
-    s.setReal([vrs["theta_M"], vrs["omega_M"], vrs["alpha_M"]], [th, om, al])
-    s.exitInitializationMode()
-    return s
+def start_inputs(slave, name):
+    """An inputs-mode instance started on S1's main shaft."""
+    return slave(name, **dict(zip(["theta_M", "omega_M", "alpha_M"], shaft(0.0))))
 
 
-def test_input_derivatives_drive_the_extrapolation(unzipdir, model_description, vrs):
+def test_input_derivatives_drive_the_extrapolation(slave, vrs):
     """theta_M with its derivatives (orders 1, 2) steps exactly like theta_M, omega_M, alpha_M
     given as inputs, and both follow the sine bench closely at a 0.5 ms step."""
-    a = start_inputs(unzipdir, model_description, vrs, "derivatives")
-    b = start_inputs(unzipdir, model_description, vrs, "inputs")
+    a = start_inputs(slave, "derivatives")
+    b = start_inputs(slave, "inputs")
     n, h = 100, 5e-4
     xa, xb = drive(a, vrs, n, h, True), drive(b, vrs, n, h, False)
     np.testing.assert_array_equal(xa, xb)
     ref = R.simulate(R.params("S1"), n * h, t_eval=h * np.arange(1, n + 1))
     assert np.max(np.abs(xa - ref.xi)) < 1e-2 * 25e-6
     # Without any derivative (theta_M alone, held speed), the same run is far worse.
-    c = start_inputs(unzipdir, model_description, vrs, "theta only")
+    c = start_inputs(slave, "theta only")
     xc = []
     for k in range(n):
         c.setReal([vrs["theta_M"]], [shaft(k * h)[0]])
@@ -60,9 +51,9 @@ def test_input_derivatives_drive_the_extrapolation(unzipdir, model_description, 
     assert np.max(np.abs(np.array(xc) - ref.xi)) > 10 * np.max(np.abs(xa - ref.xi))
 
 
-def in_contact(unzipdir, md, vrs):
+def in_contact(slave, vrs):
     """An inputs-mode instance stepped until the teeth are pressed into flank F-."""
-    s = start_inputs(unzipdir, md, vrs, "contact")
+    s = start_inputs(slave, "contact")
     h = 1e-4
     for k in range(2000):
         th, om, al = shaft(k * h)
@@ -73,8 +64,8 @@ def in_contact(unzipdir, md, vrs):
     raise AssertionError("never reached full contact on F-")
 
 
-def test_directional_derivatives_match_finite_differences(unzipdir, model_description, vrs):
-    s, _ = in_contact(unzipdir, model_description, vrs)
+def test_directional_derivatives_match_finite_differences(slave, vrs):
+    s, _ = in_contact(slave, vrs)
     state = s.getFMUstate()
     outs = ["tau_M", "F_contact", "xi", "xi_dot", "alpha_L", "a_pitch_L", "theta_L", "omega_L"]
     for inp, delta in (("theta_M", 1e-9), ("omega_M", 1e-6)):
@@ -94,13 +85,13 @@ def test_directional_derivatives_match_finite_differences(unzipdir, model_descri
     assert k < -1e3
 
 
-def test_output_derivatives_match_the_motion(unzipdir, model_description, vrs):
+def test_output_derivatives_match_the_motion(slave, vrs):
     """fmi2GetRealOutputDerivatives against the equations of motion of the independent
     reference at the FMU's own state (ξ, ξ' read at t): ξ' and ξ'' = r_L ω_L' − r_M a_M, ω_L and
     ω_L', dF/dt along the motion (central difference of the reference's contact law), r_M dF/dt.
     (A finite difference of the outputs in time would measure the dense output's derivative:
     in sine mode the FMU serves communication points from its steps' interpolants.)"""
-    s = make(unzipdir, model_description, "outder")
+    s = slave("outder", excitation=1)
     h = 1e-3
     for k in range(30):
         s.doStep(k * h, h)

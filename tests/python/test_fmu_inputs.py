@@ -66,63 +66,48 @@ def test_inputs_mode_omega_only(fmu_run):
     assert 0.5 * nr_minus <= n_minus <= 1.5 * nr_minus, (n_minus, nr_minus)
 
 
-def test_direct_feedthrough(unzipdir, model_description, vrs):
+def test_direct_feedthrough(slave, vrs):
     """Setting theta_M (omega_M) moves xi (xi_dot) at once by -r_M delta, the loose gear
     itself (theta_L, omega_L) unchanged: xi = r_L theta_L - r_M theta_M."""
-    from fmpy.fmi2 import FMU2Slave
-
     r_M = P["r_M"]
-    fmu = FMU2Slave(
-        guid=model_description.guid,
-        unzipDirectory=unzipdir,
-        modelIdentifier=model_description.coSimulation.modelIdentifier,
-        instanceName="feedthrough",
-    )
-    fmu.instantiate()
-    try:
-        fmu.setupExperiment(startTime=0.0)
-        fmu.enterInitializationMode()
-        fmu.exitInitializationMode()
-        names = ["xi", "xi_dot", "theta_L", "omega_L", "theta_M_out", "omega_M_out"]
+    fmu = slave("feedthrough")
+    names = ["xi", "xi_dot", "theta_L", "omega_L", "theta_M_out", "omega_M_out"]
 
-        def get():
-            return dict(zip(names, fmu.getReal([vrs[n] for n in names])))
+    def get():
+        return dict(zip(names, fmu.getReal([vrs[n] for n in names])))
 
-        s0 = get()
-        assert s0["xi"] == pytest.approx(0.5 * G, abs=1e-18)
-        assert s0["xi_dot"] == 0.0
-        # a few steps at rest: nothing moves (B = 0, omega_S = 0, shaft at rest)
-        t = 0.0
-        for _ in range(5):
-            fmu.doStep(currentCommunicationPoint=t, communicationStepSize=1e-3)
-            t += 1e-3
-        s1 = get()
-        assert s1["xi"] == pytest.approx(0.5 * G, abs=1e-15)
-        # theta_M -> xi, at once
-        d_theta = 1e-4
-        fmu.setReal([vrs["theta_M"]], [d_theta])
-        s2 = get()
-        assert s2["theta_M_out"] == pytest.approx(d_theta, rel=1e-12)
-        assert s2["xi"] - s1["xi"] == pytest.approx(-r_M * d_theta, rel=1e-9)
-        assert s2["theta_L"] == pytest.approx(s1["theta_L"], abs=1e-15)
-        # omega_M -> xi_dot, at once
-        d_omega = 0.5
-        fmu.setReal([vrs["omega_M"]], [d_omega])
-        s3 = get()
-        assert s3["omega_M_out"] == pytest.approx(d_omega, rel=1e-12)
-        assert s3["xi_dot"] - s2["xi_dot"] == pytest.approx(-r_M * d_omega, rel=1e-9)
-        assert s3["omega_L"] == pytest.approx(s2["omega_L"], abs=1e-15)
-        assert s3["xi"] == pytest.approx(s2["xi"], abs=1e-18)
-        # one step with constant omega_M (alpha_M = 0): the shaft angle is extrapolated
-        h = 1e-4
-        fmu.doStep(currentCommunicationPoint=t, communicationStepSize=h)
-        s4 = get()
-        assert s4["theta_M_out"] == pytest.approx(d_theta + d_omega * h, rel=1e-9)
-        # in the gap over this short step the loose gear only feels the drag: theta_L ~ same
-        assert abs(s4["theta_L"] - s3["theta_L"]) < 1e-9
-        fmu.terminate()
-    finally:
-        fmu.freeInstance()
+    s0 = get()
+    assert s0["xi"] == pytest.approx(0.5 * G, abs=1e-18)
+    assert s0["xi_dot"] == 0.0
+    # a few steps at rest: nothing moves (B = 0, omega_S = 0, shaft at rest)
+    t = 0.0
+    for _ in range(5):
+        fmu.doStep(currentCommunicationPoint=t, communicationStepSize=1e-3)
+        t += 1e-3
+    s1 = get()
+    assert s1["xi"] == pytest.approx(0.5 * G, abs=1e-15)
+    # theta_M -> xi, at once
+    d_theta = 1e-4
+    fmu.setReal([vrs["theta_M"]], [d_theta])
+    s2 = get()
+    assert s2["theta_M_out"] == pytest.approx(d_theta, rel=1e-12)
+    assert s2["xi"] - s1["xi"] == pytest.approx(-r_M * d_theta, rel=1e-9)
+    assert s2["theta_L"] == pytest.approx(s1["theta_L"], abs=1e-15)
+    # omega_M -> xi_dot, at once
+    d_omega = 0.5
+    fmu.setReal([vrs["omega_M"]], [d_omega])
+    s3 = get()
+    assert s3["omega_M_out"] == pytest.approx(d_omega, rel=1e-12)
+    assert s3["xi_dot"] - s2["xi_dot"] == pytest.approx(-r_M * d_omega, rel=1e-9)
+    assert s3["omega_L"] == pytest.approx(s2["omega_L"], abs=1e-15)
+    assert s3["xi"] == pytest.approx(s2["xi"], abs=1e-18)
+    # one step with constant omega_M (alpha_M = 0): the shaft angle is extrapolated
+    h = 1e-4
+    fmu.doStep(currentCommunicationPoint=t, communicationStepSize=h)
+    s4 = get()
+    assert s4["theta_M_out"] == pytest.approx(d_theta + d_omega * h, rel=1e-9)
+    # in the gap over this short step the loose gear only feels the drag: theta_L ~ same
+    assert abs(s4["theta_L"] - s3["theta_L"]) < 1e-9
 
 
 @pytest.mark.parametrize("scene", ["S1", "S2", "S3"])
@@ -142,35 +127,19 @@ def test_inputs_mode_drivetrain_step_1ms(fmu_run, scene):
         assert res[name][-1] == pytest.approx(int(nr[0]), rel=0.15), (name, res[name][-1], nr[0])
 
 
-def test_inputs_mode_contact_edge_crossing_one_step(unzipdir, model_description, vrs):
+def test_inputs_mode_contact_edge_crossing_one_step(slave, vrs):
     """One 1 ms step from a contact on F- (xi = G + 4.1 um, xi_dot = -5.6 mm/s) with the
     shaft decelerating (S3's inputs at t = 0.03 s): xi crosses G + eps downwards at ~0.66 ms
     (|xi_dot| ~ 1.3 mm/s), turns inside the band and goes back into full contact."""
-    from fmpy.fmi2 import FMU2Slave
-
     w, amp, t0, h = 2 * np.pi * 30.0, np.sqrt(2) * 500.0, 0.03, 1e-3
     th, om, al = -amp / w**2 * np.sin(w * t0), -amp / w * np.cos(w * t0), amp * np.sin(w * t0)
     xi0, xd0 = 2.9106500619317545e-05, -0.005591932535582747
     p = R.params(gap_start=xi0 / G, xi_dot_start=xd0)
     ref = R.simulate(p, t0 + h, shaft=lambda t: (om + al * (t - t0), al), t_start=t0)
-    fmu = FMU2Slave(
-        guid=model_description.guid,
-        unzipDirectory=unzipdir,
-        modelIdentifier=model_description.coSimulation.modelIdentifier,
-        instanceName="edge",
-    )
-    fmu.instantiate()
-    try:
-        fmu.setupExperiment(tolerance=1e-6, startTime=t0)
-        fmu.enterInitializationMode()
-        fmu.setReal([vrs["gap_start"], vrs["xi_dot_start"]], [xi0 / G, xd0])
-        fmu.setReal([vrs["theta_M"], vrs["omega_M"], vrs["alpha_M"]], [th, om, al])
-        fmu.exitInitializationMode()
-        fmu.doStep(currentCommunicationPoint=t0, communicationStepSize=h)
-        xi = fmu.getReal([vrs["xi"]])[0]
-        # the FMU's xi at the end includes -r_M (theta_M extrapolated - reference's theta_M);
-        # the reference integrates the same extrapolated shaft, so they agree closely
-        assert xi == pytest.approx(ref.final_y[0], abs=1e-4 * G)
-        fmu.terminate()
-    finally:
-        fmu.freeInstance()
+    fmu = slave("edge", start_time=t0, tolerance=1e-6, gap_start=xi0 / G, xi_dot_start=xd0,
+                theta_M=th, omega_M=om, alpha_M=al)
+    fmu.doStep(currentCommunicationPoint=t0, communicationStepSize=h)
+    xi = fmu.getReal([vrs["xi"]])[0]
+    # the FMU's xi at the end includes -r_M (theta_M extrapolated - reference's theta_M);
+    # the reference integrates the same extrapolated shaft, so they agree closely
+    assert xi == pytest.approx(ref.final_y[0], abs=1e-4 * G)

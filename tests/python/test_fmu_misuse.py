@@ -93,29 +93,26 @@ class Slave:
             return e.status
         return res
 
-    def set_real(self, refs, values):
+    def _set(self, fn, ctype, refs, values):
         n = len(refs)
-        vr = (fmi2ValueReference * n)(*refs)
-        val = (fmi2Real * n)(*values)
-        return self._status(self.fmu.fmi2SetReal, self.fmu.component, vr, n, val)
+        return self._status(fn, self.fmu.component, (fmi2ValueReference * n)(*refs), n, (ctype * n)(*values))
+
+    def _get(self, fn, ctype, refs):
+        n = len(refs)
+        val = (ctype * n)()
+        return self._status(fn, self.fmu.component, (fmi2ValueReference * n)(*refs), n, val), list(val)
+
+    def set_real(self, refs, values):
+        return self._set(self.fmu.fmi2SetReal, fmi2Real, refs, values)
 
     def get_real(self, refs):
-        n = len(refs)
-        vr = (fmi2ValueReference * n)(*refs)
-        val = (fmi2Real * n)()
-        return self._status(self.fmu.fmi2GetReal, self.fmu.component, vr, n, val), list(val)
+        return self._get(self.fmu.fmi2GetReal, fmi2Real, refs)
 
     def set_integer(self, refs, values):
-        n = len(refs)
-        vr = (fmi2ValueReference * n)(*refs)
-        val = (fmi2Integer * n)(*values)
-        return self._status(self.fmu.fmi2SetInteger, self.fmu.component, vr, n, val)
+        return self._set(self.fmu.fmi2SetInteger, fmi2Integer, refs, values)
 
     def get_integer(self, refs):
-        n = len(refs)
-        vr = (fmi2ValueReference * n)(*refs)
-        val = (fmi2Integer * n)()
-        return self._status(self.fmu.fmi2GetInteger, self.fmu.component, vr, n, val), list(val)
+        return self._get(self.fmu.fmi2GetInteger, fmi2Integer, refs)
 
     def do_step(self, h, t=None):
         t = self.t if t is None else t

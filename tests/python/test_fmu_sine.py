@@ -278,17 +278,7 @@ def test_sine_shaft_at_speed_relative_coordinates(fmu_run):
     assert res["E_lubricant"][-1] == pytest.approx(ref.final_y[3], rel=1e-3)
 
 
-def _slave(unzipdir, md, name):
-    from fmpy.fmi2 import FMU2Slave
-
-    fmu = FMU2Slave(
-        guid=md.guid, unzipDirectory=unzipdir, modelIdentifier=md.coSimulation.modelIdentifier, instanceName=name
-    )
-    fmu.instantiate()
-    return fmu
-
-
-def test_sine_communication_steps_do_not_matter(unzipdir, model_description, vrs):
+def test_sine_communication_steps_do_not_matter(slave, vrs):
     """canHandleVariableCommunicationStepSize: irregular steps (7 us to 2.3 ms) and one single
     50 ms step give the reference's xi and impact counts at the communication points."""
     rng = np.random.default_rng(20090801)
@@ -298,24 +288,15 @@ def test_sine_communication_steps_do_not_matter(unzipdir, model_description, vrs
     hs.append(0.05 - sum(hs))
     times = np.concatenate([[0.0], np.cumsum(hs)])
     ref = R.simulate(R.params("S1"), times[-1], t_eval=times)
-    names = ["xi"]
     ints = [vrs["impacts_Fplus"], vrs["impacts_Fminus"]]
 
-    fmu = _slave(unzipdir, model_description, "irregular")
-    try:
-        fmu.setupExperiment(startTime=0.0)
-        fmu.enterInitializationMode()
-        fmu.setInteger([vrs["excitation"]], [1])
-        fmu.exitInitializationMode()
-        xi = [fmu.getReal([vrs["xi"]])[0]]
-        counts = [fmu.getInteger(ints)]
-        for t, h in zip(times[:-1], hs):
-            fmu.doStep(currentCommunicationPoint=t, communicationStepSize=h)
-            xi.append(fmu.getReal([vrs[n] for n in names])[0])
-            counts.append(fmu.getInteger(ints))
-        fmu.terminate()
-    finally:
-        fmu.freeInstance()
+    fmu = slave("irregular", excitation=1)
+    xi = [fmu.getReal([vrs["xi"]])[0]]
+    counts = [fmu.getInteger(ints)]
+    for t, h in zip(times[:-1], hs):
+        fmu.doStep(currentCommunicationPoint=t, communicationStepSize=h)
+        xi.append(fmu.getReal([vrs["xi"]])[0])
+        counts.append(fmu.getInteger(ints))
     xi = np.array(xi)
     counts = np.array(counts)
     assert np.max(np.abs(xi - ref.xi)) <= 1e-4 * G
@@ -323,18 +304,10 @@ def test_sine_communication_steps_do_not_matter(unzipdir, model_description, vrs
     assert counts[:, 0].tolist() == n_plus.tolist()
     assert counts[:, 1].tolist() == n_minus.tolist()
 
-    fmu = _slave(unzipdir, model_description, "one_step")
-    try:
-        fmu.setupExperiment(startTime=0.0)
-        fmu.enterInitializationMode()
-        fmu.setInteger([vrs["excitation"]], [1])
-        fmu.exitInitializationMode()
-        fmu.doStep(currentCommunicationPoint=0.0, communicationStepSize=times[-1])
-        assert fmu.getReal([vrs["xi"]])[0] == pytest.approx(ref.xi[-1], abs=1e-4 * G)
-        assert fmu.getInteger(ints) == [int(n_plus[-1]), int(n_minus[-1])]
-        fmu.terminate()
-    finally:
-        fmu.freeInstance()
+    fmu = slave("one_step", excitation=1)
+    fmu.doStep(currentCommunicationPoint=0.0, communicationStepSize=times[-1])
+    assert fmu.getReal([vrs["xi"]])[0] == pytest.approx(ref.xi[-1], abs=1e-4 * G)
+    assert fmu.getInteger(ints) == [int(n_plus[-1]), int(n_minus[-1])]
 
 
 # ---------------------------------------------------------------------------------------

@@ -5,25 +5,9 @@ harm to the instance."""
 import numpy as np
 import pytest
 from fmpy.fmi1 import FMICallException
-from fmpy.fmi2 import FMU2Slave
 
 OUT = ["xi", "xi_dot", "F_contact", "tau_M", "E_contact", "E_lubricant", "theta_L", "omega_L"]
 COUNTERS = ["impacts_Fplus", "impacts_Fminus", "contact"]
-
-
-def make(unzipdir, md, name, excitation=1):
-    s = FMU2Slave(
-        guid=md.guid,
-        unzipDirectory=unzipdir,
-        modelIdentifier=md.coSimulation.modelIdentifier,
-        instanceName=name,
-    )
-    s.instantiate()
-    s.setupExperiment(startTime=0.0)
-    s.enterInitializationMode()
-    s.setInteger([100], [excitation])
-    s.exitInitializationMode()
-    return s
 
 
 def read(s, vrs):
@@ -44,8 +28,8 @@ def same(a, b):
     return all(np.array_equal(x[0], y[0]) and x[1] == y[1] for x, y in zip(a, b))
 
 
-def test_rollback_then_restep_is_bit_identical(unzipdir, model_description, vrs):
-    s = make(unzipdir, model_description, "rollback")
+def test_rollback_then_restep_is_bit_identical(slave, vrs):
+    s = slave("rollback", excitation=1)
     run(s, vrs, 0.0, 37, 1e-3)  # somewhere in the rattle
     state = s.getFMUstate()
     first = run(s, vrs, 0.037, 40, 5e-4)
@@ -54,26 +38,21 @@ def test_rollback_then_restep_is_bit_identical(unzipdir, model_description, vrs)
     assert same(first, again)
     assert first[-1][1][:2] != (0, 0), "impacts happened in the window"
     s.freeFMUstate(state)
-    s.terminate()
-    s.freeInstance()
 
 
-def test_serialized_state_restores_into_another_instance(unzipdir, model_description, vrs):
-    a = make(unzipdir, model_description, "a")
+def test_serialized_state_restores_into_another_instance(slave, vrs):
+    a = slave("a", excitation=1)
     run(a, vrs, 0.0, 50, 1e-3)
     blob = a.serializeFMUstate(a.getFMUstate())
-    b = make(unzipdir, model_description, "b")  # a fresh instance at t = 0
+    b = slave("b", excitation=1)  # a fresh instance at t = 0
     b.setFMUstate(b.deSerializeFMUstate(blob))
     assert same([read(a, vrs)], [read(b, vrs)])
     assert same(run(a, vrs, 0.05, 30, 1e-3), run(b, vrs, 0.05, 30, 1e-3))
-    for s in (a, b):
-        s.terminate()
-        s.freeInstance()
 
 
 @pytest.mark.parametrize("damage", ["flip", "truncate", "foreign"])
-def test_corrupt_or_foreign_state_is_refused(unzipdir, model_description, vrs, damage):
-    s = make(unzipdir, model_description, "corrupt")
+def test_corrupt_or_foreign_state_is_refused(slave, vrs, damage):
+    s = slave("corrupt", excitation=1)
     run(s, vrs, 0.0, 10, 1e-3)
     blob = bytearray(s.serializeFMUstate(s.getFMUstate()))
     if damage == "flip":
@@ -87,5 +66,3 @@ def test_corrupt_or_foreign_state_is_refused(unzipdir, model_description, vrs, d
         s.deSerializeFMUstate(bytes(blob))
     assert same([before], [read(s, vrs)])
     run(s, vrs, 0.01, 5, 1e-3)  # still usable
-    s.terminate()
-    s.freeInstance()

@@ -5,7 +5,6 @@ the FMU's own outputs sampled densely (window_reference.py)."""
 import numpy as np
 import pytest
 from fmpy import simulate_fmu
-from fmpy.fmi2 import FMU2Slave
 
 import reference as R
 import window_reference as W
@@ -123,27 +122,14 @@ def test_stats_from_moves_exactly_what_it_should(unzipdir, model_description):
     assert whole["stat_a_peak"][end] == pytest.approx(max(whole["stat_a_peak"][i01], late["stat_a_peak"][end]), rel=1e-9)
 
 
-def _stepped(unzipdir, model_description, vr, t0=0.1):
-    """An S1 instance in sine mode with stats_from = t0, initialised at t = 0."""
-    fmu = FMU2Slave(guid=model_description.guid, unzipDirectory=unzipdir,
-                    modelIdentifier=model_description.coSimulation.modelIdentifier, instanceName="stats")
-    fmu.instantiate()
-    fmu.setupExperiment(startTime=0.0)
-    fmu.enterInitializationMode()
-    fmu.setInteger([vr["excitation"]], [1])
-    fmu.setReal([vr["stats_from"]], [t0])
-    fmu.exitInitializationMode()
-    return fmu
-
-
-def test_rollback_gives_the_same_statistics(unzipdir, model_description, vrs):
+def test_rollback_gives_the_same_statistics(slave, model_description, vrs):
     """The FMU state carries the window: stepping again from a saved state (kept or
     serialized) gives the same statistics, bit for bit."""
     real = [vrs[v.name] for v in model_description.modelVariables
             if v.name.startswith("stat_") and v.type == "Real"]
     integer = [vrs[v.name] for v in model_description.modelVariables
                if v.name.startswith("stat_") and v.type == "Integer"]
-    fmu = _stepped(unzipdir, model_description, vrs)
+    fmu = slave("stats", excitation=1, stats_from=0.1)  # S1 in sine mode
     t, h = 0.0, 0.01
     for _ in range(20):  # to 0.2 s: the window is open
         fmu.doStep(t, h)
@@ -163,8 +149,6 @@ def test_rollback_gives_the_same_statistics(unzipdir, model_description, vrs):
     assert run_on() == first
     assert first[1][0] > 0  # impacts on F+ were counted
     fmu.freeFMUstate(state)
-    fmu.terminate()
-    fmu.freeInstance()
 
 
 def test_inputs_and_torque_modes_keep_statistics(fmu_run):

@@ -150,33 +150,40 @@ def _window_runs(r, t0=0.2, t1=1.0):
     return [n for _, n in R.runs(r.impact_flank[sel])]
 
 
-def test_s1_rates_and_runs():
-    r = R.scene("S1", 1.0)
+def _scene_rates(scene, rate_plus, rate_minus, **tolerance):
+    """The scene's 1 s run, its impact rates over [0.2, 1] s checked."""
+    r = R.scene(scene, 1.0)
     rt = R.rates(r.impact_t, r.impact_flank, 0.2, 1.0)
-    assert rt[R.FPLUS] == pytest.approx(150, abs=2)
-    assert rt[R.FMINUS] == pytest.approx(150, abs=2)
-    # "always 5 (the very first run: 4)": per flank, the first run has 4 impacts, all the
-    # others 5. (In time order the runs are 4 (F+), 4 (F-), 5, 5, ...)
+    assert rt[R.FPLUS] == pytest.approx(rate_plus, **tolerance)
+    assert rt[R.FMINUS] == pytest.approx(rate_minus, **tolerance)
+    return r
+
+
+def _steady_runs(r, n):
+    """Per flank, every run after the first has n impacts, and so has every run of the
+    window [0.2, 1] s; returns the run lengths per flank."""
     per = R.runs_per_flank(r.impact_flank)
     for fl in (R.FPLUS, R.FMINUS):
-        assert per[fl][0] == 4
-        assert set(per[fl][1:]) == {5}, per[fl]
-    assert set(_window_runs(r)) == {5}
+        assert set(per[fl][1:]) == {n}, per[fl]
+    assert set(_window_runs(r)) == {n}
+    return per
+
+
+def test_s1_rates_and_runs():
+    r = _scene_rates("S1", 150, 150, abs=2)
+    # "always 5 (the very first run: 4)": per flank, the first run has 4 impacts, all the
+    # others 5. (In time order the runs are 4 (F+), 4 (F-), 5, 5, ...)
+    per = _steady_runs(r, 5)
+    assert per[R.FPLUS][0] == per[R.FMINUS][0] == 4
     assert r.impact_flank[0] == R.FPLUS
 
 
 def test_s3_rates_and_runs():
-    r = R.scene("S3", 1.0)
-    rt = R.rates(r.impact_t, r.impact_flank, 0.2, 1.0)
-    assert rt[R.FPLUS] == pytest.approx(90, abs=2)
-    assert rt[R.FMINUS] == pytest.approx(90, abs=2)
+    r = _scene_rates("S3", 90, 90, abs=2)
     # "always 3". Found here: after a start transient (a first impact on F- at 2.2 ms,
     # thrown there by the lubricant drag since omega_L(0) = r_M omega_M(0) / r_L != 0,
     # then 5 on F+), every run has 3 impacts.
-    per = R.runs_per_flank(r.impact_flank)
-    for fl in (R.FPLUS, R.FMINUS):
-        assert set(per[fl][1:]) == {3}, per[fl]
-    assert set(_window_runs(r)) == {3}
+    _steady_runs(r, 3)
     # more and stronger impacts than S1? stronger: yes; fewer per second (90 vs 150)
     r1 = R.scene("S1", 1.0)
     sel3, sel1 = r.impact_t >= 0.2, r1.impact_t >= 0.2
@@ -184,11 +191,8 @@ def test_s3_rates_and_runs():
 
 
 def test_s2_rates_and_runs():
-    r = R.scene("S2", 1.0)
-    rt = R.rates(r.impact_t, r.impact_flank, 0.2, 1.0)
     # MODEL.md: ~125 / ~126 (chaotic: a few % depending on the last digits)
-    assert rt[R.FPLUS] == pytest.approx(125, rel=0.05)
-    assert rt[R.FMINUS] == pytest.approx(126, rel=0.05)
+    r = _scene_rates("S2", 125, 126, rel=0.05)
     runs = np.array(_window_runs(r))
     assert set(runs.tolist()) <= {2, 3}
     assert 0.03 <= np.mean(runs == 3) <= 0.2  # "2, a 3 about one run in ten"

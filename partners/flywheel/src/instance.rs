@@ -4,6 +4,7 @@
 
 use crate::contract::{self, Causality, Kind, LOG_CATEGORIES, VARIABLES, vr};
 use crate::model::{Params, State};
+use fmi2_shell::contract::no_variables;
 use fmi2_shell::values::Values;
 use fmi2_shell::{FmiError, FmiResult, FmiState, Identity, Interface, Log, Slave};
 use serde::{Deserialize, Serialize};
@@ -27,11 +28,6 @@ pub struct Instance {
 
 fn error(message: String) -> FmiError {
     FmiError::error(message)
-}
-
-fn variable(vr: u32) -> FmiResult<&'static contract::Variable> {
-    contract::find(Kind::Real, vr)
-        .ok_or_else(|| error(format!("unknown value reference {vr} for type Real")))
 }
 
 impl Instance {
@@ -91,15 +87,7 @@ impl Slave for Instance {
     }
 
     fn setup_experiment(&mut self, _tolerance: Option<f64>, start_time: f64) -> FmiResult {
-        if !start_time.is_finite() {
-            return Err(error(format!("startTime = {start_time} must be finite")));
-        }
         self.t = start_time;
-        Ok(())
-    }
-
-    fn enter_initialization_mode(&mut self) -> FmiResult {
-        self.state = FmiState::InitializationMode;
         Ok(())
     }
 
@@ -112,14 +100,9 @@ impl Slave for Instance {
         Ok(())
     }
 
-    fn terminate(&mut self) -> FmiResult {
-        self.state = FmiState::Terminated;
-        Ok(())
-    }
-
     fn get_real(&mut self, vrs: &[u32], out: &mut [f64]) -> FmiResult {
         for (vr, out) in vrs.iter().zip(out.iter_mut()) {
-            *out = match variable(*vr)?.causality {
+            *out = match contract::variable(Kind::Real, *vr)?.causality {
                 Causality::Output => {
                     let (p, y) = self.current()?;
                     p.output(*vr, &y, self.tau_M())
@@ -132,40 +115,14 @@ impl Slave for Instance {
     }
 
     fn get_integer(&mut self, vrs: &[u32], _out: &mut [i32]) -> FmiResult {
-        match vrs.first() {
-            None => Ok(()),
-            Some(vr) => Err(error(format!(
-                "unknown value reference {vr} for type Integer: the model has no Integer variables"
-            ))),
-        }
+        no_variables("Integer", vrs)
     }
 
     /// Sets parameters (before fmi2ExitInitializationMode) and the input. The whole call is
     /// checked first: a refused call changes nothing.
     fn set_real(&mut self, vrs: &[u32], values: &[f64]) -> FmiResult {
         for (vr, value) in vrs.iter().zip(values) {
-            let var = variable(*vr)?;
-            match var.causality {
-                Causality::Output => {
-                    return Err(error(format!(
-                        "{} is an output: it cannot be set",
-                        var.name
-                    )));
-                }
-                Causality::Parameter if self.state == FmiState::StepComplete => {
-                    return Err(error(format!(
-                        "{} is a fixed parameter: set it before fmi2ExitInitializationMode",
-                        var.name
-                    )));
-                }
-                _ => {}
-            }
-            if !value.is_finite() {
-                return Err(error(format!(
-                    "{} = {value} refused: values must be finite",
-                    var.name
-                )));
-            }
+            contract::variable(Kind::Real, *vr)?.settable_to(self.state, *value)?;
         }
         for (vr, value) in vrs.iter().zip(values) {
             self.values.set_real(*vr, *value);
@@ -173,8 +130,8 @@ impl Slave for Instance {
         Ok(())
     }
 
-    fn set_integer(&mut self, vrs: &[u32], values: &[i32]) -> FmiResult {
-        self.get_integer(vrs, &mut vec![0; values.len()])
+    fn set_integer(&mut self, vrs: &[u32], _values: &[i32]) -> FmiResult {
+        no_variables("Integer", vrs)
     }
 
     fn do_step(&mut self, current: f64, h: f64) -> FmiResult {
@@ -227,25 +184,11 @@ impl Slave for Instance {
         Ok(())
     }
 
-    /// fmi2GetRealOutputDerivatives: order 1 only (maxOutputDerivativeOrder = 1).
-    fn get_output_derivatives(
-        &mut self,
-        vrs: &[u32],
-        orders: &[i32],
-        out: &mut [f64],
-    ) -> FmiResult {
+    /// fmi2GetRealOutputDerivatives (order 1).
+    fn output_derivative(&mut self, vr: u32) -> FmiResult<f64> {
         let (p, y) = self.current()?;
-        for ((vr, order), out) in vrs.iter().zip(orders).zip(out.iter_mut()) {
-            if *order != 1 {
-                return Err(error(format!(
-                    "derivative order {order} refused: maxOutputDerivativeOrder is 1"
-                )));
-            }
-            *out = p
-                .output_derivative(*vr, &y, self.tau_M(), self.tau_dot)
-                .ok_or_else(|| error(format!("value reference {vr} is not a Real output")))?;
-        }
-        Ok(())
+        p.output_derivative(vr, &y, self.tau_M(), self.tau_dot)
+            .ok_or_else(|| error(format!("value reference {vr} is not a Real output")))
     }
 }
 
