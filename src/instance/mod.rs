@@ -58,8 +58,16 @@ enum StepRefusal {
 }
 
 /// Copies a vector of the model into the importer's array, refused if the lengths differ.
+/// A value that overflowed (states or a time beyond what the model can represent) is
+/// fmi2Discard, which asks the importer's solver for a smaller step (FMI 2.0 §2.1.3).
 fn fill<const K: usize>(what: &str, out: &mut [f64], value: [f64; K]) -> FmiResult {
     Instance::length(what, out.len(), K)?;
+    if let Some(bad) = value.iter().position(|v| !v.is_finite()) {
+        return Err(FmiError::discard(format!(
+            "{what}[{bad}] = {} at these states and time: they are beyond what the model can represent; take a smaller step",
+            value[bad]
+        )));
+    }
     out.copy_from_slice(&value);
     Ok(())
 }
