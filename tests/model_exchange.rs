@@ -94,3 +94,26 @@ fn derivatives_that_overflow_are_discarded_not_handed_out() {
         ffi::fmi2CompletedIntegratorStep(slave.c, 1, &mut enter, null_mut())
     });
 }
+
+/// A time where the sine's phase w t overflows (|t| > 1.8e308 / w, 9.5e305 s at 30 Hz)
+/// leaves the main shaft's speed NaN: fmi2SetTime refuses it and keeps the time it had, so
+/// that the states set next, and read back, stay the importer's.
+#[test]
+fn a_time_beyond_the_sine_phase_is_refused() {
+    let slave = continuous_s1("far time");
+    let x = states(&slave);
+    let s = unsafe { ffi::fmi2SetTime(slave.c, 1e307) };
+    assert_eq!(s, fmi2Status_fmi2Error);
+    let last = slave.lines().pop().expect("a refused call logs why");
+    assert!(
+        last.message
+            .starts_with("fmi2SetTime: time = 1e307 refused"),
+        "{}",
+        last.message
+    );
+    set_states(&slave, &x);
+    assert_eq!(states(&slave), x, "the states read back as set, at t = 0");
+    ok(&slave, "fmi2SetTime", unsafe {
+        ffi::fmi2SetTime(slave.c, 1e-3)
+    });
+}

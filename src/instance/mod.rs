@@ -626,8 +626,20 @@ impl Slave for Instance {
                 "time = {t} refused: it must be finite"
             )));
         }
-        self.model_exchange().set_time(t);
-        Ok(())
+        let sim = self.model_exchange();
+        let before = sim.t;
+        sim.set_time(t);
+        // The shaft's angle and speed, which fmi2SetContinuousStates needs, overflow only
+        // where the sine's phase does (the torque mode's are states, the inputs mode's held
+        // inputs): then setting the time back restores all.
+        let shaft = sim.shaft();
+        if shaft.theta.is_finite() && shaft.omega.is_finite() {
+            return Ok(());
+        }
+        sim.set_time(before);
+        Err(FmiError::error(format!(
+            "time = {t:e} refused: the main shaft's motion there is not finite ({shaft:?}), beyond what the model can represent"
+        )))
     }
 
     fn set_continuous_states(&mut self, x: &[f64]) -> FmiResult {
