@@ -117,3 +117,36 @@ fn a_time_beyond_the_sine_phase_is_refused() {
         ffi::fmi2SetTime(slave.c, 1e-3)
     });
 }
+
+/// An FMU state holds its instance's interface: one taken from a Co-Simulation instance and
+/// set into a Model Exchange one would turn it into a Co-Simulation instance. It is refused,
+/// and the instance stays as it was.
+#[test]
+fn a_state_of_the_other_interface_is_refused() {
+    let me = continuous_s1("model exchange");
+    let cs = Slave::new("co-simulation", false);
+    let (reals, integers) = s1_start(0.0);
+    cs.initialise(1e-6, &reals, &integers);
+    let mut state = null_mut();
+    unsafe {
+        ok(
+            &cs,
+            "fmi2GetFMUstate",
+            ffi::fmi2GetFMUstate(cs.c, &mut state),
+        );
+        assert_eq!(ffi::fmi2SetFMUstate(me.c, state), fmi2Status_fmi2Error);
+        ok(
+            &cs,
+            "fmi2FreeFMUstate",
+            ffi::fmi2FreeFMUstate(cs.c, &mut state),
+        );
+        assert_eq!(ffi::fmi2DoStep(me.c, 0.0, 1e-3, 1), fmi2Status_fmi2Error);
+    }
+    let last = me.lines().pop().unwrap();
+    assert!(
+        last.message.contains("illegal call sequence"),
+        "{}",
+        last.message
+    );
+    assert_eq!(derivatives(&me).0, fmi2Status_fmi2OK);
+}

@@ -329,6 +329,14 @@ pub unsafe fn set_fmu_state<S: Slave>(c: fmi2Component, state: fmi2FMUstate) -> 
     guard(c, "fmi2SetFMUstate", allowed::FMU_STATE, |s: &mut S| {
         // SAFETY: a state fmi2GetFMUstate or fmi2DeSerializeFMUstate returned.
         let saved = unsafe { fmu_state::get::<S>(state) }?;
+        // A state holds its instance's interface, which the importer's calls must keep.
+        if saved.slave.interface() != s.interface() {
+            return Err(FmiError::error(format!(
+                "the FMU state is of a {:?} instance, this one is {:?}",
+                saved.slave.interface(),
+                s.interface()
+            )));
+        }
         restore(s, &saved.slave);
         Ok(())
     })

@@ -328,8 +328,22 @@ impl Slave for Instance {
                 self.tau_in_rate
             )));
         }
-        if self.state == FmiState::StepComplete && self.sim.is_none() {
-            return Err(FmiError::error("initialised, but without a simulation"));
+        // The running states and the interface each belongs to.
+        let running = match self.state {
+            FmiState::StepComplete => Some(Interface::CoSimulation),
+            FmiState::EventMode | FmiState::ContinuousTimeMode => Some(Interface::ModelExchange),
+            _ => None,
+        };
+        if let Some(interface) = running {
+            if self.sim.is_none() {
+                return Err(FmiError::error("initialised, but without a simulation"));
+            }
+            if interface != self.interface {
+                return Err(FmiError::error(format!(
+                    "a {:?} instance in state {:?}",
+                    self.interface, self.state
+                )));
+            }
         }
         Ok(())
     }
@@ -732,14 +746,24 @@ mod tests {
     }
 
     /// Bytes with a valid checksum but made by hand are refused when the instance they
-    /// decode to could not run: an initialised one without its simulation, values missing or
-    /// not finite (the fuzzer's mended states made fmi2ExitInitializationMode panic).
+    /// decode to could not run: an initialised one without its simulation (in Co-Simulation
+    /// or Model Exchange), in a state of the other interface, values missing or not finite
+    /// (the fuzzer's mended states made fmi2ExitInitializationMode panic).
     #[test]
     fn hand_made_states_are_refused() {
         let refused = |i: &Instance| deserialize::<Instance>(&serialize(i)).unwrap_err().message;
         let mut no_sim = stepped();
         no_sim.sim = None;
         assert!(refused(&no_sim).contains("without a simulation"));
+        let mut in_event_mode = Instance::new(false, Interface::ModelExchange);
+        in_event_mode.state = FmiState::EventMode;
+        assert!(refused(&in_event_mode).contains("without a simulation"));
+        let mut stepping = stepped();
+        stepping.interface = Interface::ModelExchange;
+        assert!(refused(&stepping).contains("ModelExchange instance in state StepComplete"));
+        let mut integrating = stepped();
+        integrating.state = FmiState::ContinuousTimeMode;
+        assert!(refused(&integrating).contains("CoSimulation instance in state Continuous"));
         let mut nan = stepped();
         nan.values.set_real(vr::omega_M, f64::NAN);
         assert!(refused(&nan).contains("NaN"));
