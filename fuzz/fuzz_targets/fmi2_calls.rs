@@ -1319,8 +1319,9 @@ fuzz_target!(|input: Input| {
     } else {
         Interface::CoSimulation
     });
-    if input.start % 4 != 0 {
-        h.initialise(input.start as i32 % 4 - 1, "at the start");
+    let start = input.start % 4;
+    if start > 0 {
+        h.initialise(start as i32 - 1, "at the start");
     }
     for op in input.ops.iter().take(64) {
         h.run(op);
