@@ -151,7 +151,16 @@ macro_rules! export_co_simulation {
             fn fmi2GetFMUstate(state: *mut fmi2FMUstate)
                 FMU_STATE |s| unsafe { fmu_state::store(state, snapshot(s)) };
             fn fmi2SetFMUstate(state: fmi2FMUstate) FMU_STATE |s| {
-                restore(s, &unsafe { fmu_state::get::<S>(state) }?.slave);
+                let saved = unsafe { fmu_state::get::<S>(state) }?;
+                // A state holds its instance's interface, which the importer's calls must keep.
+                if saved.slave.interface() != s.interface() {
+                    return Err(FmiError::error(format!(
+                        "the FMU state is of a {:?} instance, this one is {:?}",
+                        saved.slave.interface(),
+                        s.interface()
+                    )));
+                }
+                restore(s, &saved.slave);
                 Ok(())
             };
             fn fmi2FreeFMUstate(state: *mut fmi2FMUstate)

@@ -1,20 +1,27 @@
-//! libFuzzer over the C API. Each input is read (`arbitrary`) as a sequence of fmi2 calls
-//! with their arguments, in any order: unknown value references, NaN, ±Inf, huge and
-//! subnormal values, zero and negative steps, serialized FMU states mutated (with their
-//! checksum mended, so that the decoder behind it is reached), strings with '%' and bytes
-//! that are not UTF-8, NULL where the standard allows it. The exports are called in-process
-//! (the crate's rlib), under AddressSanitizer and LeakSanitizer (cargo-fuzz's default).
+//! libFuzzer over the C API. Each input is read (`arbitrary`) as the interface of the first
+//! instance (Co-Simulation or Model Exchange), whether it starts initialised, and a sequence
+//! of fmi2 calls with their arguments, in any order: unknown value references, NaN, ±Inf, huge and subnormal values,
+//! zero and negative steps, times and states of any value and vectors of any length,
+//! serialized FMU states mutated (with their checksum mended, so that the decoder behind it
+//! is reached), strings with '%' and bytes that are not UTF-8, NULL where the standard allows
+//! it, and an importer's explicit Euler integration of the Model Exchange states with its
+//! event iterations. The exports are called in-process (the crate's rlib), under
+//! AddressSanitizer and LeakSanitizer (cargo-fuzz's default).
 //!
 //! Invariants, each a crash when broken:
 //! - no crash, no leak, and no panic at all (libfuzzer-sys aborts on any panic, also one the
 //!   guard would catch and turn into fmi2Error);
 //! - every status is OK, Warning, Discard or Error; every log line is a printf format with
 //!   its '%' escaped, names its own instance and reaches its own componentEnvironment;
-//! - no fmi2OK with a non-finite Real handed out (values, derivatives, status);
-//! - a refused fmi2Set* changes nothing (the instance's FMU state, byte for byte);
+//! - no fmi2OK with a non-finite Real handed out (values, derivatives, continuous states and
+//!   their derivatives, nominals, event indicators, the next event time, status);
+//! - a refused fmi2Set* (fmi2SetTime and fmi2SetContinuousStates included) changes nothing
+//!   (the instance's FMU state, byte for byte); accepted states read back as set;
+//! - an instance keeps the interface it was instantiated for;
 //! - after any sequence, fmi2SetFMUstate takes back every state fmi2GetFMUstate gave, and
 //!   fmi2Reset brings the instance back to one that runs the bench scene S1 with finite
-//!   outputs (the way out the standard gives after fmi2Error).
+//!   outputs (the way out the standard gives after fmi2Error), by fmi2DoStep or by Euler
+//!   steps of Model Exchange.
 #![no_main]
 
 #[path = "../../tests/capi/mod.rs"]
@@ -25,9 +32,10 @@ use capi::{Env, Line, callbacks, ffi, outputs};
 use fmi2_shell::component::Component;
 use fmi2_shell::fmi2::*;
 use fmi2_shell::fmu_state::serialize;
-use fmi2_shell::{FmiState, Slave as _};
+use fmi2_shell::{FmiState, Interface, Slave as _};
 use gear_rattle::contract::{GUID, Kind, LOG_CATEGORIES, VARIABLES};
 use gear_rattle::instance::Instance;
+use gear_rattle::instance::model_exchange::{NX, NZ};
 use libfuzzer_sys::fuzz_target;
 use std::ffi::CString;
 use std::ptr::{null, null_mut};
@@ -120,19 +128,81 @@ fn ptr(s: &Option<CString>) -> *const i8 {
     s.as_ref().map_or(null(), |s| s.as_ptr())
 }
 
-/// The communication point of fmi2DoStep: the instance's time, or any value.
+/// The communication point of fmi2DoStep or the time of fmi2SetTime: the instance's last
+/// successful time, a step after it, or any value.
 #[derive(Arbitrary, Debug, Clone, Copy)]
 enum When {
     Now,
+    Ahead(Size),
     At(Num),
 }
 
-/// The step size of fmi2DoStep: a usual one (10^-7 to 10^-2 s) or any value.
+/// A step size: a usual one (10^-7 to 10^-2 s) or any value.
 #[derive(Arbitrary, Debug, Clone, Copy)]
 enum Size {
     Usual(u8),
     Any(Num),
 }
+
+/// The longest step fmi2DoStep is asked for below 1e12 s. A longer one is legitimate but runs
+/// the integrator for minutes under AddressSanitizer (S1 takes 2 s for 1000 s in release),
+/// past libFuzzer's timeout, through no path a short one misses; from 1e12 s on, a step of
+/// S1 fails at once (the resolution of time at its end).
+const LONGEST_STEP: f64 = 0.1;
+
+impl Size {
+    fn get(self) -> f64 {
+        match self {
+            Size::Usual(k) => 10f64.powf(-7.0 + 5.0 * k as f64 / 255.0),
+            Size::Any(x) => x.get(),
+        }
+    }
+}
+
+/// The length of a vector of Model Exchange: the model's, or any other (0 to 31).
+#[derive(Arbitrary, Debug, Clone, Copy)]
+enum Length {
+    Model,
+    Other(u8),
+}
+
+impl Length {
+    fn of(self, model: usize) -> usize {
+        match self {
+            Length::Model => model,
+            Length::Other(n) => n as usize % 32,
+        }
+    }
+}
+
+/// The states given to fmi2SetContinuousStates.
+#[derive(Arbitrary, Debug, Clone)]
+enum States {
+    /// The instance's own (fmi2GetContinuousStates), some of them replaced.
+    Own(Vec<(u8, Num)>),
+    /// An explicit Euler step from the instance's own: x + h dx/dt.
+    Euler(Size),
+    Any(Vec<Num>),
+}
+
+/// A Model Exchange getter of a Real vector.
+type Getter = unsafe extern "C" fn(fmi2Component, *mut fmi2Real, usize) -> fmi2Status;
+
+/// The four getters, with their names and the model's lengths (`STATES`, `DERIVATIVES` and
+/// `INDICATORS` index it).
+const STATES: usize = 0;
+const DERIVATIVES: usize = 2;
+const INDICATORS: usize = 3;
+const GETTERS: [(&str, Getter, usize); 4] = [
+    ("fmi2GetContinuousStates", ffi::fmi2GetContinuousStates, NX),
+    (
+        "fmi2GetNominalsOfContinuousStates",
+        ffi::fmi2GetNominalsOfContinuousStates,
+        NX,
+    ),
+    ("fmi2GetDerivatives", ffi::fmi2GetDerivatives, NX),
+    ("fmi2GetEventIndicators", ffi::fmi2GetEventIndicators, NZ),
+];
 
 /// What is done to a serialized FMU state kept by the harness.
 #[derive(Arbitrary, Debug, Clone)]
@@ -222,6 +292,37 @@ enum Op {
         no_set_prior: bool,
     },
     CancelStep,
+    // Model Exchange.
+    SetTime {
+        when: When,
+    },
+    SetContinuousStates {
+        x: States,
+        length: Length,
+        null_values: bool,
+    },
+    /// One of the four getters of `GETTERS`.
+    GetVector {
+        which: u8,
+        length: Length,
+        null_values: bool,
+    },
+    EnterEventMode,
+    NewDiscreteStates {
+        null_info: bool,
+    },
+    EnterContinuousTimeMode,
+    CompletedIntegratorStep {
+        no_set_prior: bool,
+        null_enter: bool,
+        null_terminate: bool,
+    },
+    /// An importer's integration: `steps` explicit Euler steps of size h, each completed,
+    /// with an event iteration where an event indicator changes sign or the FMU asks.
+    Integrate {
+        steps: u8,
+        size: Size,
+    },
     GetStatus {
         kind: u32,
         which: u8,
@@ -270,6 +371,8 @@ const SLOTS: usize = 3;
 /// The harness: at most one live instance, the FMU states it holds, serialized states.
 struct Harness {
     c: fmi2Component,
+    /// The interface the live instance was instantiated for.
+    interface: Interface,
     name: String,
     env: Box<Env>,
     /// Lines of `env` already checked.
@@ -306,6 +409,33 @@ fn check_finite(call: &str, s: fmi2Status, values: &[f64]) {
     }
 }
 
+/// Runs a getter of `n` Reals into an array of `n` (NULL with `null`), checks its status
+/// and that fmi2OK hands out finite values only.
+fn get_reals(
+    call: &str,
+    n: usize,
+    null: bool,
+    get: impl FnOnce(*mut f64) -> fmi2Status,
+) -> (fmi2Status, Vec<f64>) {
+    let mut out = vec![0.0; n];
+    let dest = if null { null_mut() } else { out.as_mut_ptr() };
+    let s = check_status(call, get(dest));
+    check_finite(call, s, &out);
+    (s, out)
+}
+
+fn is_boolean(b: fmi2Boolean) -> bool {
+    b == 0 || b == 1
+}
+
+/// Whether an event indicator changed sign (the importer's test for a state event).
+fn crossed(before: &[f64], after: &[f64]) -> bool {
+    before
+        .iter()
+        .zip(after)
+        .any(|(a, b)| (*a > 0.0) != (*b > 0.0))
+}
+
 /// A printf format without a conversion: every '%' is doubled.
 fn printf_safe(message: &str) -> bool {
     let mut chars = message.chars();
@@ -319,7 +449,7 @@ fn printf_safe(message: &str) -> bool {
 
 impl Harness {
     /// A harness holding one instance, as an importer has it after fmi2Instantiate.
-    fn new() -> Self {
+    fn new(interface: Interface) -> Self {
         let env = Box::<Env>::default();
         let functions = callbacks(&*env);
         let guid = CString::new(GUID).unwrap();
@@ -327,7 +457,10 @@ impl Harness {
         let c = unsafe {
             ffi::fmi2Instantiate(
                 c"fuzz".as_ptr(),
-                fmi2Type_fmi2CoSimulation,
+                match interface {
+                    Interface::CoSimulation => fmi2Type_fmi2CoSimulation,
+                    Interface::ModelExchange => fmi2Type_fmi2ModelExchange,
+                },
                 guid.as_ptr(),
                 null(),
                 &functions,
@@ -338,6 +471,7 @@ impl Harness {
         assert!(!c.is_null(), "fmi2Instantiate with valid arguments");
         Harness {
             c,
+            interface,
             name: "fuzz".into(),
             env,
             seen: 0,
@@ -401,13 +535,184 @@ impl Harness {
 
     fn read_outputs(&self, after: &str) {
         let vrs = outputs(Kind::Real);
-        let mut out = vec![0.0; vrs.len()];
-        let s = unsafe { ffi::fmi2GetReal(self.c, vrs.as_ptr(), vrs.len(), out.as_mut_ptr()) };
-        check_finite(
+        get_reals(
             &format!("fmi2GetReal of every output after {after}"),
-            s,
-            &out,
+            vrs.len(),
+            false,
+            |out| unsafe { ffi::fmi2GetReal(self.c, vrs.as_ptr(), vrs.len(), out) },
         );
+    }
+
+    fn at(&self, when: When) -> f64 {
+        match when {
+            When::Now => self.time(),
+            When::Ahead(h) => self.time() + h.get(),
+            When::At(x) => x.get(),
+        }
+    }
+
+    /// One of Model Exchange's vectors (`GETTERS`), asked with any length.
+    fn get_vector(&self, which: usize, length: Length, null: bool) -> (fmi2Status, Vec<f64>) {
+        let (call, get, n) = GETTERS[which];
+        let (c, n) = (self.c, length.of(n));
+        get_reals(call, n, null, |out| unsafe { get(c, out, n) })
+    }
+
+    /// One of Model Exchange's vectors of the model's length, or None if refused.
+    fn own(&self, which: usize) -> Option<Vec<f64>> {
+        let (s, v) = self.get_vector(which, Length::Model, false);
+        status_ok(s).then_some(v)
+    }
+
+    /// The states an importer's explicit Euler step of size h reaches (None if refused).
+    fn euler(&self, h: f64) -> Option<Vec<f64>> {
+        let (x, dx) = (self.own(STATES)?, self.own(DERIVATIVES)?);
+        Some(x.iter().zip(&dx).map(|(x, dx)| x + h * dx).collect())
+    }
+
+    fn states(&self, x: &States) -> Vec<f64> {
+        match x {
+            States::Own(edits) => {
+                let mut x = self.own(STATES).unwrap_or_else(|| vec![0.0; NX]);
+                for (k, v) in edits {
+                    x[*k as usize % NX] = v.get();
+                }
+                x
+            }
+            States::Euler(h) => self.euler(h.get()).unwrap_or_default(),
+            States::Any(values) => values.iter().map(|v| v.get()).collect(),
+        }
+    }
+
+    /// fmi2SetContinuousStates; accepted, ξ and the quadratures (the states every drive
+    /// mode keeps as given) read back as set.
+    fn set_continuous_states(&mut self, x: &[f64], null_values: bool) -> fmi2Status {
+        let c = self.c;
+        let src = if null_values { null() } else { x.as_ptr() };
+        let s = self.unchanged_if_refused("fmi2SetContinuousStates", || unsafe {
+            ffi::fmi2SetContinuousStates(c, src, x.len())
+        });
+        if status_ok(s) {
+            let (s, back) = self.get_vector(STATES, Length::Model, false);
+            assert!(
+                status_ok(s) && back[0] == x[0] && back[4..] == x[4..],
+                "fmi2SetContinuousStates({x:?}) reads back as {back:?} ({s}; log {:?})",
+                self.env.lines.lock().unwrap().last()
+            );
+        }
+        s
+    }
+
+    /// fmi2NewDiscreteStates: what it reports, or None if refused.
+    fn new_discrete_states(&self, null: bool) -> Option<fmi2EventInfo> {
+        let mut info = fmi2EventInfo {
+            newDiscreteStatesNeeded: 2,
+            terminateSimulation: 2,
+            nominalsOfContinuousStatesChanged: 2,
+            valuesOfContinuousStatesChanged: 2,
+            nextEventTimeDefined: 2,
+            nextEventTime: f64::NAN,
+        };
+        let dest = if null { null_mut() } else { &mut info };
+        let s = check_status("fmi2NewDiscreteStates", unsafe {
+            ffi::fmi2NewDiscreteStates(self.c, dest)
+        });
+        if !status_ok(s) {
+            return None;
+        }
+        assert!(
+            [
+                info.newDiscreteStatesNeeded,
+                info.terminateSimulation,
+                info.nominalsOfContinuousStatesChanged,
+                info.valuesOfContinuousStatesChanged,
+                info.nextEventTimeDefined
+            ]
+            .into_iter()
+            .all(is_boolean)
+                && (info.nextEventTimeDefined == 0 || info.nextEventTime.is_finite()),
+            "fmi2NewDiscreteStates returned fmi2OK with {info:?}"
+        );
+        Some(info)
+    }
+
+    /// The event iteration from event mode to continuous-time mode; whether it got there.
+    fn event_iteration(&self) -> bool {
+        for _ in 0..4 {
+            match self.new_discrete_states(false) {
+                Some(info) if info.newDiscreteStatesNeeded == 0 => {
+                    return status_ok(check_status("fmi2EnterContinuousTimeMode", unsafe {
+                        ffi::fmi2EnterContinuousTimeMode(self.c)
+                    }));
+                }
+                Some(_) => {}
+                None => return false,
+            }
+        }
+        false
+    }
+
+    /// fmi2CompletedIntegratorStep: whether the FMU asks for event mode, or None if refused.
+    fn completed_integrator_step(&self, no_set_prior: bool, null: [bool; 2]) -> Option<bool> {
+        let (mut enter, mut terminate) = (2, 2);
+        let ptr = |p: &mut fmi2Boolean, null: bool| if null { null_mut() } else { p as *mut _ };
+        let s = check_status("fmi2CompletedIntegratorStep", unsafe {
+            ffi::fmi2CompletedIntegratorStep(
+                self.c,
+                no_set_prior as fmi2Boolean,
+                ptr(&mut enter, null[0]),
+                ptr(&mut terminate, null[1]),
+            )
+        });
+        if !status_ok(s) {
+            return None;
+        }
+        assert!(
+            (null[0] || is_boolean(enter)) && (null[1] || is_boolean(terminate)),
+            "fmi2CompletedIntegratorStep returned fmi2OK with {enter}, {terminate}"
+        );
+        Some(enter == 1)
+    }
+
+    /// An importer's Model Exchange loop: from event mode an event iteration, then `steps`
+    /// explicit Euler steps of size h, each completed, and an event iteration where an event
+    /// indicator changes sign or the FMU asks for one. Whether every call returned fmi2OK.
+    fn integrate(&mut self, steps: usize, h: f64) -> bool {
+        let c = self.c;
+        if self
+            .component()
+            .is_some_and(|c| c.slave.state() == FmiState::EventMode)
+            && !self.event_iteration()
+        {
+            return false;
+        }
+        let Some(mut z) = self.own(INDICATORS) else {
+            return false;
+        };
+        for _ in 0..steps {
+            let t = self.time() + h;
+            let Some(x) = self.euler(h) else {
+                return false;
+            };
+            let s = check_status("fmi2SetTime", unsafe { ffi::fmi2SetTime(c, t) });
+            if !status_ok(s) || !status_ok(self.set_continuous_states(&x, false)) {
+                return false;
+            }
+            let (Some(enter), Some(after)) = (
+                self.completed_integrator_step(true, [false; 2]),
+                self.own(INDICATORS),
+            ) else {
+                return false;
+            };
+            if enter || crossed(&z, &after) {
+                let s = check_status("fmi2EnterEventMode", unsafe { ffi::fmi2EnterEventMode(c) });
+                if !status_ok(s) || !self.event_iteration() {
+                    return false;
+                }
+            }
+            z = after;
+        }
+        true
     }
 
     fn run(&mut self, op: &Op) {
@@ -425,9 +730,10 @@ impl Harness {
                 self.env = Box::default();
                 self.seen = 0;
                 let functions = callbacks(&*self.env);
-                // Co-Simulation, or a type that is neither (Model Exchange's calls are not fuzzed).
-                let kind = match fmu_type % 2 {
+                // Co-Simulation, Model Exchange, or a type that is neither.
+                let kind = match fmu_type % 3 {
                     0 => fmi2Type_fmi2CoSimulation,
+                    1 => fmi2Type_fmi2ModelExchange,
                     _ => 2 + *fmu_type as fmi2Type,
                 };
                 self.name = n
@@ -446,10 +752,16 @@ impl Harness {
                     )
                 };
                 if !self.c.is_null() {
-                    assert!(
-                        kind == fmi2Type_fmi2CoSimulation
-                            && g.as_deref() == Some(CString::new(GUID).unwrap().as_c_str())
-                    );
+                    assert!(g.as_deref() == Some(CString::new(GUID).unwrap().as_c_str()));
+                    self.interface = if kind == fmi2Type_fmi2CoSimulation {
+                        Interface::CoSimulation
+                    } else {
+                        assert_eq!(
+                            kind, fmi2Type_fmi2ModelExchange,
+                            "an instance of fmuType {kind}"
+                        );
+                        Interface::ModelExchange
+                    };
                 }
             }
             Op::FreeInstance => self.free_instance(),
@@ -502,16 +814,9 @@ impl Harness {
             }
             Op::GetReal { vrs, null_values } => {
                 let vrs: Vec<u32> = vrs.iter().map(|v| v.get()).collect();
-                let mut out = vec![0.0; vrs.len()];
-                let dest = if *null_values {
-                    null_mut()
-                } else {
-                    out.as_mut_ptr()
-                };
-                let s = check_status("fmi2GetReal", unsafe {
-                    ffi::fmi2GetReal(c, vrs.as_ptr(), vrs.len(), dest)
+                get_reals("fmi2GetReal", vrs.len(), *null_values, |out| unsafe {
+                    ffi::fmi2GetReal(c, vrs.as_ptr(), vrs.len(), out)
                 });
-                check_finite("fmi2GetReal", s, &out);
             }
             Op::GetInteger { vrs } => {
                 let vrs: Vec<u32> = vrs.iter().map(|v| v.get()).collect();
@@ -584,48 +889,52 @@ impl Harness {
             Op::GetRealOutputDerivatives { vrs } => {
                 let (vrs, orders): (Vec<u32>, Vec<i32>) =
                     vrs.iter().map(|(r, o)| (r.get(), *o)).unzip();
-                let mut out = vec![0.0; vrs.len()];
-                let s = check_status("fmi2GetRealOutputDerivatives", unsafe {
-                    ffi::fmi2GetRealOutputDerivatives(
-                        c,
-                        vrs.as_ptr(),
-                        vrs.len(),
-                        orders.as_ptr(),
-                        out.as_mut_ptr(),
-                    )
-                });
-                check_finite("fmi2GetRealOutputDerivatives", s, &out);
+                get_reals(
+                    "fmi2GetRealOutputDerivatives",
+                    vrs.len(),
+                    false,
+                    |out| unsafe {
+                        ffi::fmi2GetRealOutputDerivatives(
+                            c,
+                            vrs.as_ptr(),
+                            vrs.len(),
+                            orders.as_ptr(),
+                            out,
+                        )
+                    },
+                );
             }
             Op::GetDirectionalDerivative { unknowns, knowns } => {
                 let u: Vec<u32> = unknowns.iter().map(|v| v.get()).collect();
                 let (k, dv): (Vec<u32>, Vec<f64>) =
                     knowns.iter().map(|(r, x)| (r.get(), x.get())).unzip();
-                let mut out = vec![0.0; u.len()];
-                let s = check_status("fmi2GetDirectionalDerivative", unsafe {
-                    ffi::fmi2GetDirectionalDerivative(
-                        c,
-                        u.as_ptr(),
-                        u.len(),
-                        k.as_ptr(),
-                        k.len(),
-                        dv.as_ptr(),
-                        out.as_mut_ptr(),
-                    )
-                });
-                check_finite("fmi2GetDirectionalDerivative", s, &out);
+                get_reals(
+                    "fmi2GetDirectionalDerivative",
+                    u.len(),
+                    false,
+                    |out| unsafe {
+                        ffi::fmi2GetDirectionalDerivative(
+                            c,
+                            u.as_ptr(),
+                            u.len(),
+                            k.as_ptr(),
+                            k.len(),
+                            dv.as_ptr(),
+                            out,
+                        )
+                    },
+                );
             }
             Op::DoStep {
                 when,
                 size,
                 no_set_prior,
             } => {
-                let t = match when {
-                    When::Now => self.time(),
-                    When::At(x) => x.get(),
-                };
-                let h = match size {
-                    Size::Usual(k) => 10f64.powf(-7.0 + 5.0 * *k as f64 / 255.0),
-                    Size::Any(x) => x.get(),
+                let (t, h) = (self.at(*when), size.get());
+                let h = if h > LONGEST_STEP && h < 1e12 {
+                    LONGEST_STEP
+                } else {
+                    h
                 };
                 let s = check_status("fmi2DoStep", unsafe {
                     ffi::fmi2DoStep(c, t, h, *no_set_prior as fmi2Boolean)
@@ -636,6 +945,47 @@ impl Harness {
             }
             Op::CancelStep => {
                 check_status("fmi2CancelStep", unsafe { ffi::fmi2CancelStep(c) });
+            }
+            Op::SetTime { when } => {
+                let t = self.at(*when);
+                self.unchanged_if_refused("fmi2SetTime", || unsafe { ffi::fmi2SetTime(c, t) });
+            }
+            Op::SetContinuousStates {
+                x,
+                length,
+                null_values,
+            } => {
+                let mut x = self.states(x);
+                x.resize(length.of(NX), 0.0);
+                self.set_continuous_states(&x, *null_values);
+            }
+            Op::GetVector {
+                which,
+                length,
+                null_values,
+            } => {
+                self.get_vector(*which as usize % GETTERS.len(), *length, *null_values);
+            }
+            Op::EnterEventMode => {
+                check_status("fmi2EnterEventMode", unsafe { ffi::fmi2EnterEventMode(c) });
+            }
+            Op::NewDiscreteStates { null_info } => {
+                self.new_discrete_states(*null_info);
+            }
+            Op::EnterContinuousTimeMode => {
+                check_status("fmi2EnterContinuousTimeMode", unsafe {
+                    ffi::fmi2EnterContinuousTimeMode(c)
+                });
+            }
+            Op::CompletedIntegratorStep {
+                no_set_prior,
+                null_enter,
+                null_terminate,
+            } => {
+                self.completed_integrator_step(*no_set_prior, [*null_enter, *null_terminate]);
+            }
+            Op::Integrate { steps, size } => {
+                self.integrate(*steps as usize % 16 + 1, size.get());
             }
             Op::GetStatus { kind, which } => {
                 let (mut s, mut r, mut i, mut b, mut t) = (0, 0.0, 0, 0, null());
@@ -774,7 +1124,7 @@ impl Harness {
 
     /// Runs a fmi2Set* call; refused with the instance still in a working state, it must
     /// have left the FMU state as it was.
-    fn unchanged_if_refused(&mut self, call: &str, f: impl FnOnce() -> fmi2Status) {
+    fn unchanged_if_refused(&mut self, call: &str, f: impl FnOnce() -> fmi2Status) -> fmi2Status {
         let before = self.fmu_state_bytes();
         let s = check_status(call, f());
         if !status_ok(s)
@@ -785,6 +1135,18 @@ impl Harness {
             assert!(
                 self.fmu_state_bytes() == before,
                 "{call} was refused ({s}) but changed the FMU state"
+            );
+        }
+        s
+    }
+
+    /// The instance still has the interface it was instantiated for.
+    fn check_interface(&self) {
+        if let Some(c) = self.component() {
+            assert_eq!(
+                c.slave.interface(),
+                self.interface,
+                "the instance changed its interface"
             );
         }
     }
@@ -822,8 +1184,38 @@ impl Harness {
         }));
     }
 
+    /// Sets up and initialises the instance from t = 0 in a drive mode (`excitation`: 0
+    /// inputs, 1 sine as in the bench scene S1, 2 torque), the other values at their start.
+    fn initialise(&self, excitation: i32, when: &str) {
+        let c = self.c;
+        let (vr, v) = ([gear_rattle::contract::vr::excitation], [excitation]);
+        unsafe {
+            for (call, s) in [
+                (
+                    "fmi2SetupExperiment",
+                    ffi::fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0),
+                ),
+                (
+                    "fmi2EnterInitializationMode",
+                    ffi::fmi2EnterInitializationMode(c),
+                ),
+                (
+                    "fmi2SetInteger",
+                    ffi::fmi2SetInteger(c, vr.as_ptr(), 1, v.as_ptr()),
+                ),
+                (
+                    "fmi2ExitInitializationMode",
+                    ffi::fmi2ExitInitializationMode(c),
+                ),
+            ] {
+                assert!(status_ok(s), "{call} {when}: {s}");
+            }
+        }
+    }
+
     /// The ways back the standard gives after any sequence: the states fmi2GetFMUstate
-    /// made are taken back, and fmi2Reset leads to a working run of S1.
+    /// made are taken back, and fmi2Reset leads to a working run of S1 (a step of 2 ms in
+    /// Co-Simulation, ten Euler steps of 1 µs in Model Exchange).
     fn check_usable(&mut self) {
         if self.c.is_null() {
             return;
@@ -838,32 +1230,13 @@ impl Harness {
                 );
             }
         }
-        unsafe {
-            assert!(status_ok(ffi::fmi2Reset(c)), "fmi2Reset");
-            assert!(
-                status_ok(ffi::fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0)),
-                "fmi2SetupExperiment after fmi2Reset"
-            );
-            assert!(
-                status_ok(ffi::fmi2EnterInitializationMode(c)),
-                "fmi2EnterInitializationMode after fmi2Reset"
-            );
-            let (vr, v) = ([gear_rattle::contract::vr::excitation], [1]);
-            assert!(status_ok(ffi::fmi2SetInteger(
-                c,
-                vr.as_ptr(),
-                1,
-                v.as_ptr()
-            )));
-            assert!(
-                status_ok(ffi::fmi2ExitInitializationMode(c)),
-                "fmi2ExitInitializationMode after fmi2Reset"
-            );
-            assert!(
-                status_ok(ffi::fmi2DoStep(c, 0.0, 2e-3, 1)),
-                "fmi2DoStep of S1 after fmi2Reset"
-            );
-        }
+        assert!(status_ok(unsafe { ffi::fmi2Reset(c) }), "fmi2Reset");
+        self.initialise(1, "after fmi2Reset");
+        let stepped = match self.interface {
+            Interface::CoSimulation => status_ok(unsafe { ffi::fmi2DoStep(c, 0.0, 2e-3, 1) }),
+            Interface::ModelExchange => self.integrate(10, 1e-6),
+        };
+        assert!(stepped, "a step of S1 after fmi2Reset");
         self.read_outputs("fmi2Reset and a step of S1");
         let ints = outputs(Kind::Integer);
         let mut out = vec![0; ints.len()];
@@ -900,8 +1273,15 @@ fn null_component(which: u8) {
     let c = null_mut();
     let (mut r, mut i, mut state) = ([0.0], [0], null_mut());
     let vr = [0u32];
+    let (mut b, mut info) = (0, std::mem::MaybeUninit::<fmi2EventInfo>::uninit());
     let s = unsafe {
-        match which % 10 {
+        match which % 16 {
+            10 => ffi::fmi2SetTime(c, 0.0),
+            11 => ffi::fmi2SetContinuousStates(c, r.as_ptr(), 1),
+            12 => ffi::fmi2GetDerivatives(c, r.as_mut_ptr(), 1),
+            13 => ffi::fmi2NewDiscreteStates(c, info.as_mut_ptr()),
+            14 => ffi::fmi2CompletedIntegratorStep(c, 0, &mut b, &mut b),
+            15 => ffi::fmi2EnterEventMode(c),
             0 => ffi::fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0),
             1 => ffi::fmi2EnterInitializationMode(c),
             2 => ffi::fmi2DoStep(c, 0.0, 1e-3, 0),
@@ -920,11 +1300,30 @@ fn null_component(which: u8) {
     assert_eq!(s, fmi2Status_fmi2Error, "a call with a NULL component");
 }
 
-fuzz_target!(|ops: Vec<Op>| {
+/// One input: the interface of the first instance, where it starts, and the calls. `start`
+/// modulo 4: 0 just instantiated, else initialised in the drive mode `start % 4 - 1` (so
+/// that the calls of a running instance are reached without first finding the sequence
+/// that initialises it).
+#[derive(Arbitrary, Debug)]
+struct Input {
+    model_exchange: bool,
+    start: u8,
+    ops: Vec<Op>,
+}
+
+fuzz_target!(|input: Input| {
     // FUZZ_TRACE=1 (replaying a crash): each call, then the instance's state and time.
     let trace = std::env::var_os("FUZZ_TRACE").is_some();
-    let mut h = Harness::new();
-    for op in ops.iter().take(64) {
+    let mut h = Harness::new(if input.model_exchange {
+        Interface::ModelExchange
+    } else {
+        Interface::CoSimulation
+    });
+    let start = input.start % 4;
+    if start > 0 {
+        h.initialise(start as i32 - 1, "at the start");
+    }
+    for op in input.ops.iter().take(64) {
         h.run(op);
         if trace {
             let now = h
@@ -936,6 +1335,7 @@ fuzz_target!(|ops: Vec<Op>| {
             );
         }
         h.check_log();
+        h.check_interface();
     }
     h.check_usable();
     h.check_log();

@@ -58,8 +58,16 @@ enum StepRefusal {
 }
 
 /// Copies a vector of the model into the importer's array, refused if the lengths differ.
+/// A value that overflowed (states or a time beyond what the model can represent) is
+/// fmi2Discard, which asks the importer's solver for a smaller step (FMI 2.0 §2.1.3).
 fn fill<const K: usize>(what: &str, out: &mut [f64], value: [f64; K]) -> FmiResult {
     Instance::length(what, out.len(), K)?;
+    if let Some(bad) = value.iter().position(|v| !v.is_finite()) {
+        return Err(FmiError::discard(format!(
+            "{what}[{bad}] = {} at these states and time: they are beyond what the model can represent; take a smaller step",
+            value[bad]
+        )));
+    }
     out.copy_from_slice(&value);
     Ok(())
 }
@@ -295,8 +303,22 @@ impl Slave for Instance {
                 self.tau_in_rate
             )));
         }
-        if self.state == FmiState::StepComplete && self.sim.is_none() {
-            return Err(FmiError::error("initialised, but without a simulation"));
+        // The running states and the interface each belongs to.
+        let running = match self.state {
+            FmiState::StepComplete => Some(Interface::CoSimulation),
+            FmiState::EventMode | FmiState::ContinuousTimeMode => Some(Interface::ModelExchange),
+            _ => None,
+        };
+        if let Some(interface) = running {
+            if self.sim.is_none() {
+                return Err(FmiError::error("initialised, but without a simulation"));
+            }
+            if interface != self.interface {
+                return Err(FmiError::error(format!(
+                    "a {:?} instance in state {:?}",
+                    self.interface, self.state
+                )));
+            }
         }
         Ok(())
     }
@@ -564,8 +586,20 @@ impl Slave for Instance {
                 "time = {t} refused: it must be finite"
             )));
         }
-        self.model_exchange().set_time(t);
-        Ok(())
+        let sim = self.model_exchange();
+        let before = sim.t;
+        sim.set_time(t);
+        // The shaft's angle and speed, which fmi2SetContinuousStates needs, overflow only
+        // where the sine's phase does (the torque mode's are states, the inputs mode's held
+        // inputs): then setting the time back restores all.
+        let shaft = sim.shaft();
+        if shaft.theta.is_finite() && shaft.omega.is_finite() {
+            return Ok(());
+        }
+        sim.set_time(before);
+        Err(FmiError::error(format!(
+            "time = {t:e} refused: the main shaft's motion there is not finite ({shaft:?}), beyond what the model can represent"
+        )))
     }
 
     fn set_continuous_states(&mut self, x: &[f64]) -> FmiResult {
@@ -658,14 +692,24 @@ mod tests {
     }
 
     /// Bytes with a valid checksum but made by hand are refused when the instance they
-    /// decode to could not run: an initialised one without its simulation, values missing or
-    /// not finite (the fuzzer's mended states made fmi2ExitInitializationMode panic).
+    /// decode to could not run: an initialised one without its simulation (in Co-Simulation
+    /// or Model Exchange), in a state of the other interface, values missing or not finite
+    /// (the fuzzer's mended states made fmi2ExitInitializationMode panic).
     #[test]
     fn hand_made_states_are_refused() {
         let refused = |i: &Instance| deserialize::<Instance>(&serialize(i)).unwrap_err().message;
         let mut no_sim = stepped();
         no_sim.sim = None;
         assert!(refused(&no_sim).contains("without a simulation"));
+        let mut in_event_mode = Instance::new(false, Interface::ModelExchange);
+        in_event_mode.state = FmiState::EventMode;
+        assert!(refused(&in_event_mode).contains("without a simulation"));
+        let mut stepping = stepped();
+        stepping.interface = Interface::ModelExchange;
+        assert!(refused(&stepping).contains("ModelExchange instance in state StepComplete"));
+        let mut integrating = stepped();
+        integrating.state = FmiState::ContinuousTimeMode;
+        assert!(refused(&integrating).contains("CoSimulation instance in state Continuous"));
         let mut nan = stepped();
         nan.values.set_real(vr::omega_M, f64::NAN);
         assert!(refused(&nan).contains("NaN"));

@@ -10,7 +10,8 @@ use gear_rattle::contract::{Causality, GUID, Kind, VARIABLES, vr};
 use std::ffi::{CStr, CString, c_void};
 use std::sync::Mutex;
 
-/// The exports of FMI 2.0 Co-Simulation, as the standard's header declares them.
+/// The exports of FMI 2.0 Co-Simulation and Model Exchange, as the standard's header declares
+/// them.
 #[allow(non_snake_case, clippy::too_many_arguments)]
 pub mod ffi {
     use fmi2_shell::fmi2::*;
@@ -166,6 +167,30 @@ pub mod ffi {
             size: usize,
             state: *mut fmi2FMUstate,
         ) -> fmi2Status;
+        pub fn fmi2SetTime(c: fmi2Component, time: fmi2Real) -> fmi2Status;
+        pub fn fmi2SetContinuousStates(
+            c: fmi2Component,
+            x: *const fmi2Real,
+            nx: usize,
+        ) -> fmi2Status;
+        pub fn fmi2GetContinuousStates(c: fmi2Component, x: *mut fmi2Real, nx: usize)
+        -> fmi2Status;
+        pub fn fmi2GetNominalsOfContinuousStates(
+            c: fmi2Component,
+            x_nominal: *mut fmi2Real,
+            nx: usize,
+        ) -> fmi2Status;
+        pub fn fmi2GetDerivatives(c: fmi2Component, dx: *mut fmi2Real, nx: usize) -> fmi2Status;
+        pub fn fmi2GetEventIndicators(c: fmi2Component, z: *mut fmi2Real, ni: usize) -> fmi2Status;
+        pub fn fmi2EnterEventMode(c: fmi2Component) -> fmi2Status;
+        pub fn fmi2NewDiscreteStates(c: fmi2Component, info: *mut fmi2EventInfo) -> fmi2Status;
+        pub fn fmi2EnterContinuousTimeMode(c: fmi2Component) -> fmi2Status;
+        pub fn fmi2CompletedIntegratorStep(
+            c: fmi2Component,
+            noSetFMUStatePriorToCurrentPoint: fmi2Boolean,
+            enterEventMode: *mut fmi2Boolean,
+            terminateSimulation: *mut fmi2Boolean,
+        ) -> fmi2Status;
     }
 }
 
@@ -277,7 +302,12 @@ pub fn ok(slave: &Slave, call: &str, status: fmi2Status) {
 }
 
 impl Slave {
+    /// A Co-Simulation instance.
     pub fn new(name: &str, logging_on: bool) -> Slave {
+        Slave::of_type(name, fmi2Type_fmi2CoSimulation, logging_on)
+    }
+
+    pub fn of_type(name: &str, fmu_type: fmi2Type, logging_on: bool) -> Slave {
         let env = Box::<Env>::default();
         let functions = callbacks(&*env);
         let (cname, guid) = (CString::new(name).unwrap(), CString::new(GUID).unwrap());
@@ -285,7 +315,7 @@ impl Slave {
         let c = unsafe {
             ffi::fmi2Instantiate(
                 cname.as_ptr(),
-                fmi2Type_fmi2CoSimulation,
+                fmu_type,
                 guid.as_ptr(),
                 c"file:///nowhere".as_ptr(),
                 &functions,
