@@ -290,6 +290,98 @@ impl Instance {
     }
 }
 
+impl Instance {
+    /// Co-simulation's directional derivative: of outputs along inputs ([`Simulation::partial`]).
+    fn output_directional_derivative(
+        &mut self,
+        unknowns: &[u32],
+        knowns: &[u32],
+        dv_known: &[f64],
+        dv_unknown: &mut [f64],
+    ) -> FmiResult {
+        for k in knowns {
+            let var = Self::variable(Kind::Real, *k)?;
+            if var.causality != Causality::Input {
+                return Err(FmiError::error(format!(
+                    "{} is not an input: directional derivatives are taken with respect to theta_M, omega_M, alpha_M, tau_in",
+                    var.name
+                )));
+            }
+        }
+        let sim = self.current()?;
+        for (u, out) in unknowns.iter().zip(dv_unknown) {
+            let var = Self::variable(Kind::Real, *u)?;
+            if var.causality != Causality::Output {
+                return Err(FmiError::error(format!(
+                    "{} is not an output: directional derivatives are of outputs",
+                    var.name
+                )));
+            }
+            let partials = knowns.iter().map(|k| sim.partial(*u, *k));
+            *out = seeded(var, partials, dv_known)?;
+        }
+        Ok(())
+    }
+
+    /// Model Exchange's directional derivative: of the state derivatives and the outputs
+    /// that have one ([`model_exchange::Jacobian`]) along the states and the inputs.
+    fn model_exchange_directional_derivative(
+        &mut self,
+        unknowns: &[u32],
+        knowns: &[u32],
+        dv_known: &[f64],
+        dv_unknown: &mut [f64],
+    ) -> FmiResult {
+        let columns = knowns
+            .iter()
+            .map(|k| {
+                let var = Self::variable(Kind::Real, *k)?;
+                model_exchange::column(*k).ok_or_else(|| {
+                    let states = contract::STATES
+                        .iter()
+                        .filter_map(|s| contract::find(Kind::Real, *s).map(|v| v.name));
+                    FmiError::error(format!(
+                        "{} is neither a continuous state nor an input: Model Exchange's directional derivatives are taken with respect to the states {} and the inputs theta_M, omega_M, alpha_M, tau_in",
+                        var.name,
+                        states.collect::<Vec<_>>().join(", ")
+                    ))
+                })
+            })
+            .collect::<FmiResult<Vec<usize>>>()?;
+        let jacobian = self.current()?.jacobian();
+        for (u, out) in unknowns.iter().zip(dv_unknown) {
+            let var = Self::variable(Kind::Real, *u)?;
+            let Some(gradient) = jacobian.gradient(*u) else {
+                return Err(FmiError::error(format!(
+                    "{} is not an unknown of Model Exchange's directional derivatives: they are given for the state derivatives der(...) and the outputs {}",
+                    var.name,
+                    jacobian.outputs().collect::<Vec<_>>().join(", ")
+                )));
+            };
+            let partials = columns.iter().map(|&c| gradient.0[c]);
+            *out = seeded(var, partials, dv_known)?;
+        }
+        Ok(())
+    }
+}
+
+/// Σ_k partial_k · dv_k, refused if it overflows.
+fn seeded(
+    var: &contract::Variable,
+    partials: impl Iterator<Item = f64>,
+    dv_known: &[f64],
+) -> FmiResult<f64> {
+    let sum: f64 = partials.zip(dv_known).map(|(p, dv)| p * dv).sum();
+    if sum.is_finite() {
+        Ok(sum)
+    } else {
+        Err(FmiError::error(format!(
+            "the derivative of {} along dvKnown overflows ({sum}): scale the seed vector down",
+            var.name
+        )))
+    }
+}
+
 impl Slave for Instance {
     const IDENTITY: Identity = Identity {
         guid: contract::GUID,
@@ -564,7 +656,8 @@ impl Slave for Instance {
         Ok(())
     }
 
-    /// fmi2GetDirectionalDerivative: dv_unknown = J · dv_known with J = ∂outputs/∂inputs.
+    /// fmi2GetDirectionalDerivative: dv_unknown = J · dv_known. Co-simulation: J =
+    /// ∂outputs/∂inputs; Model Exchange: J = ∂(derivatives, outputs)/∂(states, inputs).
     fn directional_derivative(
         &mut self,
         unknowns: &[u32],
@@ -572,42 +665,19 @@ impl Slave for Instance {
         dv_known: &[f64],
         dv_unknown: &mut [f64],
     ) -> FmiResult {
-        for k in knowns {
-            let var = Self::variable(Kind::Real, *k)?;
-            if var.causality != Causality::Input {
-                return Err(FmiError::error(format!(
-                    "{} is not an input: directional derivatives are taken with respect to theta_M, omega_M, alpha_M, tau_in",
-                    var.name
-                )));
-            }
-        }
         if let Some(dv) = dv_known.iter().find(|dv| !dv.is_finite()) {
             return Err(FmiError::error(format!(
                 "dvKnown = {dv} refused: the seed vector must be finite"
             )));
         }
-        let sim = self.current()?;
-        for (u, out) in unknowns.iter().zip(dv_unknown) {
-            let var = Self::variable(Kind::Real, *u)?;
-            if var.causality != Causality::Output {
-                return Err(FmiError::error(format!(
-                    "{} is not an output: directional derivatives are of outputs",
-                    var.name
-                )));
+        match self.interface {
+            Interface::CoSimulation => {
+                self.output_directional_derivative(unknowns, knowns, dv_known, dv_unknown)
             }
-            *out = knowns
-                .iter()
-                .zip(dv_known)
-                .map(|(k, dv)| sim.partial(*u, *k) * dv)
-                .sum();
-            if !out.is_finite() {
-                return Err(FmiError::error(format!(
-                    "the derivative of {} along dvKnown overflows ({out}): scale the seed vector down",
-                    var.name
-                )));
+            Interface::ModelExchange => {
+                self.model_exchange_directional_derivative(unknowns, knowns, dv_known, dv_unknown)
             }
         }
-        Ok(())
     }
 
     // Model Exchange (see `model_exchange`).
