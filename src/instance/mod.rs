@@ -290,96 +290,42 @@ impl Instance {
     }
 }
 
-impl Instance {
-    /// Co-simulation's directional derivative: of outputs along inputs ([`Simulation::partial`]).
-    fn output_directional_derivative(
-        &mut self,
-        unknowns: &[u32],
-        knowns: &[u32],
-        dv_known: &[f64],
-        dv_unknown: &mut [f64],
-    ) -> FmiResult {
-        for k in knowns {
-            let var = Self::variable(Kind::Real, *k)?;
-            if var.causality != Causality::Input {
-                return Err(FmiError::error(format!(
-                    "{} is not an input: directional derivatives are taken with respect to theta_M, omega_M, alpha_M, tau_in",
-                    var.name
-                )));
-            }
+/// dv_unknown = J · dv_known, with the row of J of each unknown (its partials along the
+/// knowns) from `row`, which refuses the unknowns it has none for; refused where a sum
+/// overflows.
+fn directional(
+    unknowns: &[u32],
+    dv_known: &[f64],
+    dv_unknown: &mut [f64],
+    mut row: impl FnMut(&contract::Variable) -> FmiResult<Vec<f64>>,
+) -> FmiResult {
+    for (u, out) in unknowns.iter().zip(dv_unknown) {
+        let var = Instance::variable(Kind::Real, *u)?;
+        let sum: f64 = row(var)?.iter().zip(dv_known).map(|(p, dv)| p * dv).sum();
+        if !sum.is_finite() {
+            return Err(FmiError::error(format!(
+                "the derivative of {} along dvKnown overflows ({sum}): scale the seed vector down",
+                var.name
+            )));
         }
-        let sim = self.current()?;
-        for (u, out) in unknowns.iter().zip(dv_unknown) {
-            let var = Self::variable(Kind::Real, *u)?;
-            if var.causality != Causality::Output {
-                return Err(FmiError::error(format!(
-                    "{} is not an output: directional derivatives are of outputs",
-                    var.name
-                )));
-            }
-            let partials = knowns.iter().map(|k| sim.partial(*u, *k));
-            *out = seeded(var, partials, dv_known)?;
-        }
-        Ok(())
+        *out = sum;
     }
-
-    /// Model Exchange's directional derivative: of the state derivatives and the outputs
-    /// that have one ([`model_exchange::Jacobian`]) along the states and the inputs.
-    fn model_exchange_directional_derivative(
-        &mut self,
-        unknowns: &[u32],
-        knowns: &[u32],
-        dv_known: &[f64],
-        dv_unknown: &mut [f64],
-    ) -> FmiResult {
-        let columns = knowns
-            .iter()
-            .map(|k| {
-                let var = Self::variable(Kind::Real, *k)?;
-                model_exchange::column(*k).ok_or_else(|| {
-                    let states = contract::STATES
-                        .iter()
-                        .filter_map(|s| contract::find(Kind::Real, *s).map(|v| v.name));
-                    FmiError::error(format!(
-                        "{} is neither a continuous state nor an input: Model Exchange's directional derivatives are taken with respect to the states {} and the inputs theta_M, omega_M, alpha_M, tau_in",
-                        var.name,
-                        states.collect::<Vec<_>>().join(", ")
-                    ))
-                })
-            })
-            .collect::<FmiResult<Vec<usize>>>()?;
-        let jacobian = self.current()?.jacobian();
-        for (u, out) in unknowns.iter().zip(dv_unknown) {
-            let var = Self::variable(Kind::Real, *u)?;
-            let Some(gradient) = jacobian.gradient(*u) else {
-                return Err(FmiError::error(format!(
-                    "{} is not an unknown of Model Exchange's directional derivatives: they are given for the state derivatives der(...) and the outputs {}",
-                    var.name,
-                    jacobian.outputs().collect::<Vec<_>>().join(", ")
-                )));
-            };
-            let partials = columns.iter().map(|&c| gradient.0[c]);
-            *out = seeded(var, partials, dv_known)?;
-        }
-        Ok(())
-    }
+    Ok(())
 }
 
-/// Σ_k partial_k · dv_k, refused if it overflows.
-fn seeded(
-    var: &contract::Variable,
-    partials: impl Iterator<Item = f64>,
-    dv_known: &[f64],
-) -> FmiResult<f64> {
-    let sum: f64 = partials.zip(dv_known).map(|(p, dv)| p * dv).sum();
-    if sum.is_finite() {
-        Ok(sum)
-    } else {
-        Err(FmiError::error(format!(
-            "the derivative of {} along dvKnown overflows ({sum}): scale the seed vector down",
-            var.name
-        )))
-    }
+/// The column of Model Exchange's Jacobian of a known: a continuous state or an input.
+fn model_exchange_column(known: u32) -> FmiResult<usize> {
+    let var = Instance::variable(Kind::Real, known)?;
+    model_exchange::column(known).ok_or_else(|| {
+        let states = contract::STATES
+            .iter()
+            .filter_map(|s| contract::find(Kind::Real, *s).map(|v| v.name));
+        FmiError::error(format!(
+            "{} is neither a continuous state nor an input: Model Exchange's directional derivatives are taken with respect to the states {} and the inputs theta_M, omega_M, alpha_M, tau_in",
+            var.name,
+            states.collect::<Vec<_>>().join(", ")
+        ))
+    })
 }
 
 impl Slave for Instance {
@@ -657,7 +603,8 @@ impl Slave for Instance {
     }
 
     /// fmi2GetDirectionalDerivative: dv_unknown = J · dv_known. Co-simulation: J =
-    /// ∂outputs/∂inputs; Model Exchange: J = ∂(derivatives, outputs)/∂(states, inputs).
+    /// ∂outputs/∂inputs ([`Simulation::partial`]); Model Exchange: J = ∂(derivatives,
+    /// outputs)/∂(states, inputs) ([`model_exchange::Jacobian`]).
     fn directional_derivative(
         &mut self,
         unknowns: &[u32],
@@ -672,10 +619,42 @@ impl Slave for Instance {
         }
         match self.interface {
             Interface::CoSimulation => {
-                self.output_directional_derivative(unknowns, knowns, dv_known, dv_unknown)
+                for k in knowns {
+                    let var = Self::variable(Kind::Real, *k)?;
+                    if var.causality != Causality::Input {
+                        return Err(FmiError::error(format!(
+                            "{} is not an input: directional derivatives are taken with respect to theta_M, omega_M, alpha_M, tau_in",
+                            var.name
+                        )));
+                    }
+                }
+                let sim = self.current()?;
+                directional(unknowns, dv_known, dv_unknown, |var| {
+                    if var.causality != Causality::Output {
+                        return Err(FmiError::error(format!(
+                            "{} is not an output: directional derivatives are of outputs",
+                            var.name
+                        )));
+                    }
+                    Ok(knowns.iter().map(|k| sim.partial(var.vr, *k)).collect())
+                })
             }
             Interface::ModelExchange => {
-                self.model_exchange_directional_derivative(unknowns, knowns, dv_known, dv_unknown)
+                let columns = knowns
+                    .iter()
+                    .map(|k| model_exchange_column(*k))
+                    .collect::<FmiResult<Vec<usize>>>()?;
+                let jacobian = self.current()?.jacobian();
+                directional(unknowns, dv_known, dv_unknown, |var| {
+                    let gradient = jacobian.gradient(var.vr).ok_or_else(|| {
+                        FmiError::error(format!(
+                            "{} is not an unknown of Model Exchange's directional derivatives: they are given for the state derivatives der(...) and the outputs {}",
+                            var.name,
+                            jacobian.outputs().collect::<Vec<_>>().join(", ")
+                        ))
+                    })?;
+                    Ok(columns.iter().map(|&c| gradient.0[c]).collect())
+                })
             }
         }
     }
