@@ -80,7 +80,7 @@ pub fn column(known: u32) -> Option<usize> {
 /// The gradients of the derivatives and of the outputs that have one, at one point.
 pub struct Jacobian {
     /// ∂ẋ_i/∂known, in the state vector's order.
-    pub derivatives: [Gradient; NX],
+    derivatives: [Gradient; NX],
     theta_L: Gradient,
     omega_L: Gradient,
     alpha_L: Gradient,
@@ -99,7 +99,7 @@ impl Jacobian {
         let p = &point.dynamics.params;
         let law = &point.dynamics.law;
         let (loads, shaft) = (&point.loads, &point.shaft);
-        let input = |u: u32| NX + INPUTS.iter().position(|&i| i == u).expect("an input");
+        let input = |u: u32| column(u).expect("an input");
         // The primitives' gradients.
         let d_xi = Gradient::unit(X_XI);
         let d_omega_L = Gradient::unit(X_OMEGA_L);
@@ -129,7 +129,8 @@ impl Jacobian {
         let d_alpha_L = (1.0 / p.I_L) * (-p.r_L * d_force - p.C * d_omega_L);
         let d_alpha_M = match point.shaft_from {
             ShaftFrom::States(main) => (1.0 / main.I_M) * (d_tau + p.r_M * d_force),
-            // The inputs mode holds the shaft's speed between the importer's inputs.
+            // A function of time (sine mode), or 0: the inputs mode holds the shaft's speed
+            // between the importer's inputs.
             _ => Gradient::ZERO,
         };
         let (d_x_theta_M, d_x_omega_M) = match point.shaft_from {
