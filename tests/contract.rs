@@ -1,18 +1,27 @@
 //! The contract (modelDescription/GearRattle.toml) against what the simulation computes:
 //! every output is computed in every coupling, each output's derivative is given exactly
-//! where the contract says so, and each Real output moves with an input at once exactly
-//! where its `depends_on` (the model description's ModelStructure) says so.
+//! where the contract says so, each Real output moves with an input at once exactly where
+//! its `depends_on` (the model description's ModelStructure) says so, and each Model
+//! Exchange state derivative with the states and inputs its `depends_on` names.
 
 use fmi2_shell::values::Values;
 use gear_rattle::contract::{Causality, Kind, VARIABLES, Variable, vr};
 use gear_rattle::instance::Simulation;
+use gear_rattle::instance::model_exchange::column;
+use std::collections::BTreeSet;
 
 /// A simulation in contact on F+ and moving (so that the contact's stiffness and damping
 /// both act), with the main shaft driven by `excitation`.
 fn in_contact(excitation: i64) -> Simulation {
+    starting_at(excitation, -0.2)
+}
+
+/// A simulation starting at ξ = gap_start G and moving, with the main shaft driven by
+/// `excitation`.
+fn starting_at(excitation: i64, gap_start: f64) -> Simulation {
     let mut values = Values::start(gear_rattle::contract::VARIABLES);
     values.set_integer(vr::excitation, excitation);
-    values.set_real(vr::gap_start, -0.2);
+    values.set_real(vr::gap_start, gap_start);
     values.set_real(vr::xi_dot_start, 0.01);
     values.set_real(vr::omega_M, 3.0);
     values.set_real(vr::alpha_M, 40.0);
@@ -103,6 +112,45 @@ fn partials_are_non_zero_exactly_where_depends_on_says() {
             moved, declared,
             "{}: inputs it moves with, against depends_on",
             v.name
+        );
+    }
+}
+
+/// Model Exchange: ∂ẋ_i/∂known of fmi2GetDirectionalDerivative's Jacobian is non-zero, in
+/// some region of the contact law (both contacts, both bands, the gap) and some drive mode,
+/// exactly for the states and inputs of der(x_i)'s `depends_on` (ModelStructure/Derivatives).
+#[test]
+fn state_derivatives_move_exactly_with_what_depends_on_says() {
+    let knowns: Vec<&Variable> = VARIABLES
+        .iter()
+        .filter(|v| v.kind == Kind::Real && column(v.vr).is_some())
+        .collect();
+    let jacobians: Vec<_> = COUPLINGS
+        .iter()
+        .flat_map(|&excitation| {
+            [-0.2, -0.02, 0.5, 1.02, 1.2]
+                .map(|gap_start| starting_at(excitation, gap_start).jacobian())
+        })
+        .collect();
+    let derivatives = VARIABLES
+        .iter()
+        .filter(|v| gear_rattle::contract::DERIVATIVES.contains(&v.vr));
+    for d in derivatives {
+        let moved: BTreeSet<&str> = knowns
+            .iter()
+            .filter(|k| {
+                let c = column(k.vr).expect("a known");
+                jacobians
+                    .iter()
+                    .any(|j| j.gradient(d.vr).expect("a derivative").0[c] != 0.0)
+            })
+            .map(|k| k.name)
+            .collect();
+        let declared: BTreeSet<&str> = d.depends_on.iter().copied().collect();
+        assert_eq!(
+            moved, declared,
+            "{}: what it moves with, against depends_on",
+            d.name
         );
     }
 }

@@ -146,13 +146,25 @@ fn check(c: &Contract) {
                 v.name
             );
         }
+        // An output depends on inputs; a state derivative on inputs and states.
+        let is_state = |name: &str| {
+            c.variable
+                .iter()
+                .any(|w| w.derivative_of.as_deref() == Some(name))
+        };
         for d in v.depends_on.iter().flatten() {
             assert!(
                 c.variable
                     .iter()
-                    .any(|w| &w.name == d && w.causality == "input"),
-                "{}: depends on {d}, which is not an input",
-                v.name
+                    .any(|w| &w.name == d && w.causality == "input")
+                    || (v.derivative_of.is_some() && is_state(d)),
+                "{}: depends on {d}, which is not an input{}",
+                v.name,
+                if v.derivative_of.is_some() {
+                    " or a continuous state"
+                } else {
+                    ""
+                }
             );
         }
     }
@@ -305,16 +317,14 @@ fn xml(c: &Contract, guid: &str) -> String {
         .zip(&c.variable)
         .filter(|(_, v)| v.causality == "output")
         .collect();
-    for (i, v) in &outputs {
-        let deps: Vec<String> = v
-            .depends_on
-            .iter()
-            .flatten()
-            .map(|d| index_of(d).to_string())
-            .collect();
+    // An unknown with its dependencies (indices in increasing order), as declared.
+    let unknown = |x: &mut String, i: usize, v: &Variable| {
+        let mut deps: Vec<usize> = v.depends_on.iter().flatten().map(|d| index_of(d)).collect();
+        deps.sort();
         if deps.is_empty() {
             writeln!(x, "      <Unknown index=\"{i}\" dependencies=\"\"/>").unwrap();
         } else {
+            let deps: Vec<String> = deps.iter().map(usize::to_string).collect();
             let kinds = vec!["dependent"; deps.len()].join(" ");
             writeln!(
                 x,
@@ -323,26 +333,28 @@ fn xml(c: &Contract, guid: &str) -> String {
             )
             .unwrap();
         }
+    };
+    for (i, v) in &outputs {
+        unknown(&mut x, *i, v);
     }
     x += "    </Outputs>\n";
-    // Model Exchange: the state derivatives, in the order of the state vector (each depends
-    // on every state and input: no dependencies are declared).
-    let derivatives: Vec<usize> = (1..)
+    // Model Exchange: the state derivatives, in the order of the state vector, with the
+    // states and inputs each depends on.
+    let derivatives: Vec<(usize, &Variable)> = (1..)
         .zip(&c.variable)
         .filter(|(_, v)| v.derivative_of.is_some())
-        .map(|(i, _)| i)
         .collect();
     if !derivatives.is_empty() {
         x += "    <Derivatives>\n";
-        for i in &derivatives {
-            writeln!(x, "      <Unknown index=\"{i}\"/>").unwrap();
+        for (i, v) in &derivatives {
+            unknown(&mut x, *i, v);
         }
         x += "    </Derivatives>\n";
     }
     x += "    <InitialUnknowns>\n";
     // Outputs, and the states and their derivatives (all calculated: none has a start).
     let mut initial: Vec<usize> = outputs.iter().map(|(i, _)| *i).collect();
-    initial.extend(&derivatives);
+    initial.extend(derivatives.iter().map(|(i, _)| *i));
     initial.extend(
         c.variable
             .iter()

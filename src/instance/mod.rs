@@ -273,6 +273,44 @@ impl Instance {
     }
 }
 
+/// dv_unknown = J · dv_known, with the row of J of each unknown (its partials along the
+/// knowns) from `row`, which refuses the unknowns it has none for; refused where a sum
+/// overflows.
+fn directional(
+    unknowns: &[u32],
+    dv_known: &[f64],
+    dv_unknown: &mut [f64],
+    mut row: impl FnMut(&contract::Variable) -> FmiResult<Vec<f64>>,
+) -> FmiResult {
+    for (u, out) in unknowns.iter().zip(dv_unknown) {
+        let var = contract::variable(Kind::Real, *u)?;
+        let sum: f64 = row(var)?.iter().zip(dv_known).map(|(p, dv)| p * dv).sum();
+        if !sum.is_finite() {
+            return Err(FmiError::error(format!(
+                "the derivative of {} along dvKnown overflows ({sum}): scale the seed vector down",
+                var.name
+            )));
+        }
+        *out = sum;
+    }
+    Ok(())
+}
+
+/// The column of Model Exchange's Jacobian of a known: a continuous state or an input.
+fn model_exchange_column(known: u32) -> FmiResult<usize> {
+    let var = contract::variable(Kind::Real, known)?;
+    model_exchange::column(known).ok_or_else(|| {
+        let states = contract::STATES
+            .iter()
+            .filter_map(|s| contract::find(Kind::Real, *s).map(|v| v.name));
+        FmiError::error(format!(
+            "{} is neither a continuous state nor an input: Model Exchange's directional derivatives are taken with respect to the states {} and the inputs theta_M, omega_M, alpha_M, tau_in",
+            var.name,
+            states.collect::<Vec<_>>().join(", ")
+        ))
+    })
+}
+
 impl Slave for Instance {
     const IDENTITY: Identity = Identity {
         guid: contract::GUID,
@@ -532,7 +570,9 @@ impl Slave for Instance {
         }
     }
 
-    /// fmi2GetDirectionalDerivative: dv_unknown = J · dv_known with J = ∂outputs/∂inputs.
+    /// fmi2GetDirectionalDerivative: dv_unknown = J · dv_known. Co-simulation: J =
+    /// ∂outputs/∂inputs ([`Simulation::partial`]); Model Exchange: J = ∂(derivatives,
+    /// outputs)/∂(states, inputs) ([`model_exchange::Jacobian`]).
     fn directional_derivative(
         &mut self,
         unknowns: &[u32],
@@ -540,42 +580,51 @@ impl Slave for Instance {
         dv_known: &[f64],
         dv_unknown: &mut [f64],
     ) -> FmiResult {
-        for k in knowns {
-            let var = contract::variable(Kind::Real, *k)?;
-            if var.causality != Causality::Input {
-                return Err(FmiError::error(format!(
-                    "{} is not an input: directional derivatives are taken with respect to theta_M, omega_M, alpha_M, tau_in",
-                    var.name
-                )));
-            }
-        }
         if let Some(dv) = dv_known.iter().find(|dv| !dv.is_finite()) {
             return Err(FmiError::error(format!(
                 "dvKnown = {dv} refused: the seed vector must be finite"
             )));
         }
-        let sim = self.current()?;
-        for (u, out) in unknowns.iter().zip(dv_unknown) {
-            let var = contract::variable(Kind::Real, *u)?;
-            if var.causality != Causality::Output {
-                return Err(FmiError::error(format!(
-                    "{} is not an output: directional derivatives are of outputs",
-                    var.name
-                )));
+        match self.interface {
+            Interface::CoSimulation => {
+                for k in knowns {
+                    let var = contract::variable(Kind::Real, *k)?;
+                    if var.causality != Causality::Input {
+                        return Err(FmiError::error(format!(
+                            "{} is not an input: directional derivatives are taken with respect to theta_M, omega_M, alpha_M, tau_in",
+                            var.name
+                        )));
+                    }
+                }
+                let sim = self.current()?;
+                directional(unknowns, dv_known, dv_unknown, |var| {
+                    if var.causality != Causality::Output {
+                        return Err(FmiError::error(format!(
+                            "{} is not an output: directional derivatives are of outputs",
+                            var.name
+                        )));
+                    }
+                    Ok(knowns.iter().map(|k| sim.partial(var.vr, *k)).collect())
+                })
             }
-            *out = knowns
-                .iter()
-                .zip(dv_known)
-                .map(|(k, dv)| sim.partial(*u, *k) * dv)
-                .sum();
-            if !out.is_finite() {
-                return Err(FmiError::error(format!(
-                    "the derivative of {} along dvKnown overflows ({out}): scale the seed vector down",
-                    var.name
-                )));
+            Interface::ModelExchange => {
+                let columns = knowns
+                    .iter()
+                    .map(|k| model_exchange_column(*k))
+                    .collect::<FmiResult<Vec<usize>>>()?;
+                let jacobian = self.current()?.jacobian();
+                directional(unknowns, dv_known, dv_unknown, |var| {
+                    let gradient = jacobian.gradient(var.vr).ok_or_else(|| {
+                        FmiError::error(format!(
+                            "{} is not an unknown of Model Exchange's directional derivatives: they are given for the state derivatives der(...) and the outputs {}",
+                            var.name,
+                            jacobian.outputs().collect::<Vec<_>>().join(", ")
+                        ))
+                    })?;
+                    Ok(columns.iter().map(|&c| gradient.0[c]).collect())
+                })
             }
         }
-        Ok(())
     }
 
     // Model Exchange (see `model_exchange`).

@@ -17,8 +17,12 @@
 //! co-simulation.
 #![allow(non_snake_case)]
 
+mod jacobian;
+
+pub use jacobian::{Jacobian, column};
+
 use super::simulation::{Drive, Gear, Simulation};
-use crate::physics::{Excitation, Polynomial, Region, Shaft};
+use crate::physics::{Dynamics, Excitation, Loads, MainShaft, Polynomial, Region, Shaft};
 use crate::rattle::window::quadrature;
 use crate::rattle::{GearPair, XI, XI_DOT, quadrature_rates, torque};
 
@@ -26,6 +30,30 @@ use crate::rattle::{GearPair, XI, XI_DOT, quadrature_rates, torque};
 pub const NX: usize = 4 + quadrature::COUNT;
 /// Number of event indicators.
 pub const NZ: usize = 5;
+
+/// What the derivatives are computed from at the current time and states.
+pub(super) struct Point<'a> {
+    pub dynamics: &'a Dynamics,
+    /// The region ξ is in, whose formula the derivatives take.
+    pub region: Region,
+    pub xi: f64,
+    pub xi_dot: f64,
+    pub loads: Loads,
+    /// The main shaft's motion (torque mode: with the acceleration the contact gives it).
+    pub shaft: Shaft,
+    pub shaft_from: ShaftFrom,
+}
+
+/// Where the main shaft's angle and speed come from.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) enum ShaftFrom {
+    /// The sine mode: functions of time.
+    Time,
+    /// The inputs mode: the inputs theta_M and omega_M.
+    Inputs,
+    /// The torque mode: the states x_theta_M and x_omega_M of a shaft of this inertia.
+    States(MainShaft),
+}
 
 /// Nominal magnitudes of the states, for the importer's error weights: ξ on the scale of
 /// the backlash, speeds of 10 rad/s, a shaft angle of 1 rad, the energies and integrals on
@@ -67,35 +95,70 @@ impl Simulation {
         }
     }
 
+    /// The right-hand side's operating point at the current time and states, with the
+    /// formula of the region ξ is in.
+    pub(super) fn point(&self) -> Point<'_> {
+        let now = self.now();
+        let (dynamics, xi, xi_dot) = (now.dynamics, now.xi, now.xi_dot);
+        let region = dynamics.law.classify(xi);
+        let (loads, shaft, shaft_from) = match &self.gear {
+            Gear::Kinematic(k) => {
+                let shaft = k.system.excitation.at(self.t);
+                let shaft_from = match self.drive {
+                    Drive::Inputs(_) => ShaftFrom::Inputs,
+                    _ => ShaftFrom::Time,
+                };
+                (
+                    dynamics.loads(region, xi, xi_dot, &shaft),
+                    shaft,
+                    shaft_from,
+                )
+            }
+            Gear::Torque(k) => {
+                let mut system = k.system;
+                system.region = region;
+                let (loads, shaft) = system.loads(self.t, &k.y);
+                (loads, shaft, ShaftFrom::States(k.system.main))
+            }
+        };
+        Point {
+            dynamics,
+            region,
+            xi,
+            xi_dot,
+            loads,
+            shaft,
+            shaft_from,
+        }
+    }
+
     /// dx/dt at the current time and states, with the formula of the region ξ is in: the
     /// contact force is continuous with a continuous slope across the edges (MODEL.md §2),
     /// so the importer's solver sees a smooth enough right-hand side wherever its trial
     /// points fall, also past an edge it has not located yet.
     pub fn derivatives(&self) -> [f64; NX] {
+        let Point {
+            dynamics,
+            loads,
+            shaft,
+            shaft_from,
+            ..
+        } = self.point();
+        let p = &dynamics.params;
         let mut dx = [0.0; NX];
-        let (loads, shaft, p) = match &self.gear {
-            Gear::Kinematic(k) => {
-                let mut system = k.system;
-                system.region = system.dynamics.law.classify(k.y[XI]);
-                let shaft = system.excitation.at(self.t);
-                (
-                    system.loads_at(self.t, &k.y),
-                    shaft,
-                    &k.system.dynamics.params,
-                )
-            }
-            Gear::Torque(k) => {
-                let mut system = k.system;
-                system.region = system.dynamics.law.classify(k.y[XI]);
-                let (loads, shaft) = system.loads(self.t, &k.y);
-                (dx[2], dx[3]) = (shaft.omega, shaft.alpha);
-                (loads, shaft, &k.system.dynamics.params)
-            }
-        };
         let xi_dot = p.r_L * loads.omega_L - p.r_M * shaft.omega;
         (dx[0], dx[1]) = (xi_dot, loads.alpha_L);
+        if let ShaftFrom::States(_) = shaft_from {
+            (dx[2], dx[3]) = (shaft.omega, shaft.alpha);
+        }
         dx[4..].copy_from_slice(&quadrature_rates(p, &loads, xi_dot, shaft.omega));
         dx
+    }
+
+    /// ∂ẋ/∂(x, u) and the outputs' partials at the current time and states
+    /// (fmi2GetDirectionalDerivative; see [`Jacobian`]).
+    pub fn jacobian(&self) -> Jacobian {
+        Jacobian::new(&self.point())
     }
 
     /// The event indicators: ξ against the contact law's four edges, and in the gap ξ' (1
@@ -117,18 +180,25 @@ impl Simulation {
         nominals(self.now().dynamics.params.G)
     }
 
-    /// The importer's time. In the inputs mode the shaft's inputs hold until set again.
+    /// The importer's time. In the inputs mode the shaft's inputs hold until set again. The
+    /// states x stay as set: in the sine mode the shaft's speed moves with t, so ξ' is
+    /// recomputed from ω_L.
     pub fn set_time(&mut self, t: f64) {
+        let x = self.continuous_states();
         self.t = t;
         self.hold_inputs();
+        self.set_continuous_states(&x);
     }
 
     /// New shaft inputs (inputs mode) as the importer sets them: unlike co-simulation's
-    /// [`Simulation::set_shaft`], the states do not move (ξ is the importer's state).
+    /// [`Simulation::set_shaft`], the states x do not move (ξ and ω_L are the importer's), so
+    /// ξ' follows the new ω_M.
     pub fn set_shaft_inputs(&mut self, shaft: Shaft) {
         if let Drive::Inputs(_) = self.drive {
+            let x = self.continuous_states();
             self.drive = Drive::Inputs(shaft);
             self.hold_inputs();
+            self.set_continuous_states(&x);
         }
     }
 
