@@ -106,8 +106,9 @@ class Drivetrain:
         self.close()
 
     def _set(self, t: float, y: np.ndarray):
-        """Time, inputs, then states: GearRattle derives ξ' from the state ω_L and the shaft's
-        speed as they are when the states are set, so the time and the inputs go first."""
+        """Time, inputs, then states: the states are then taken with the shaft's speed they
+        belong to, also by an FMU that derives internal quantities (here ξ' from ω_L and
+        ω_M) when the states are set."""
         f = self.fmu
         f.setTime(t)
         self._shaft[0], self._shaft[1] = y[self.nx], y[self.nx + 1]
