@@ -32,7 +32,7 @@ test-flywheel:
 test-masters: fmu $(FLYWHEEL_FMU) $(VENV)/.installed | libtbb
 	$(PY) -m pytest -q tests/masters
 
-## coupling-study: coupling error vs communication step -> docs/COUPLING.md, docs/coupling_error.png
+## coupling-study: coupling error vs communication step, and Model Exchange vs tolerance -> docs/COUPLING.md, docs/coupling_error.png
 coupling-study: fmu $(FLYWHEEL_FMU) $(VENV)/.installed | libtbb
 	$(PY) scripts/coupling_study.py --out docs
 

@@ -11,9 +11,10 @@ State z = [xi, xi_dot, E_contact, E_lubricant, theta_M, omega_M, phi, omega_E]:
   its second component is then r_L omega_L', from which the contact force F follows
   (I_L omega_L' = B - r_L F - C (omega_L - omega_S)), so the contact law, the loose gear's
   equation and the energies are the reference's own, not a copy;
-* the drivetrain (partners/flywheel/src/model.rs): phi = theta_E - theta_M,
+* the drivetrain (partners/flywheel/src/model.rs, `drivetrain`): phi = theta_E - theta_M,
   T_d = k_d phi + c_d (omega_E - omega_M), I_M omega_M' = T_d + r_M F,
-  I_E omega_E' = T_mean + T_2 sin(2 theta_E) - (T_mean / omega_idle) omega_E - T_d;
+  I_E omega_E' = T_mean + T_2 sin(2 theta_E) - (T_mean / omega_idle) omega_E - T_d; the
+  Model Exchange master (model_exchange.py) puts the same function around GearRattle;
 * xi'' = r_L omega_L' - r_M omega_M'.
 """
 
@@ -82,13 +83,28 @@ def gear_params(**overrides) -> dict:
     return R.params(**{**GEAR, **overrides})
 
 
-def _coupled_rhs(pg: dict, pf: dict, code: int):
-    r_L, r_M, I_L, B, C, om_s = pg["r_L"], pg["r_M"], pg["I_L"], pg["B"], pg["C"], pg["omega_S"]
+def drivetrain(pf: dict):
+    """The Flywheel's equations (partners/flywheel/src/model.rs) as a function
+    accelerations(theta_M, phi, omega_M, omega_E, tau_M) -> (omega_M', omega_E'), tau_M being
+    the torque the gear pair exerts on the main shaft (r_M F): the clutch damper's
+    T_d = k_d phi + c_d (omega_E - omega_M), I_M omega_M' = T_d + tau_M,
+    I_E omega_E' = T_mean + T_2 sin(2 theta_E) - (T_mean / omega_idle) omega_E - T_d."""
     I_E, I_M, k_d, c_d, T_mean, T_2 = (pf[k] for k in ("I_E", "I_M", "k_d", "c_d", "T_mean", "T_2"))
     d_E = T_mean / pf["omega_idle"]
+    sin = math.sin
+
+    def accelerations(theta_M, phi, om_m, om_e, tau_M):
+        t_d = k_d * phi + c_d * (om_e - om_m)
+        return (t_d + tau_M) / I_M, (T_mean + T_2 * sin(2.0 * (theta_M + phi)) - d_E * om_e - t_d) / I_E
+
+    return accelerations
+
+
+def _coupled_rhs(pg: dict, pf: dict, code: int):
+    r_L, r_M, I_L, B, C, om_s = pg["r_L"], pg["r_M"], pg["I_L"], pg["B"], pg["C"], pg["omega_S"]
+    accelerations = drivetrain(pf)
     shaft_speed = [0.0]
     gear = R._make_rhs(pg, code, shaft=lambda t: (shaft_speed[0], 0.0))
-    sin = math.sin
 
     def rhs(t, z):
         om_m, phi, om_e = z[5], z[6], z[7]
@@ -96,9 +112,7 @@ def _coupled_rhs(pg: dict, pf: dict, code: int):
         g = gear(t, z[:4])  # [xi_dot, r_L omega_L' (a_M = 0), dE_contact, dE_lubricant]
         om_rel = (z[1] + r_M * om_m) / r_L - om_s
         force = (B - C * om_rel - I_L * g[1] / r_L) / r_L
-        t_d = k_d * phi + c_d * (om_e - om_m)
-        a_m = (t_d + r_M * force) / I_M
-        a_e = (T_mean + T_2 * sin(2.0 * (z[4] + phi)) - d_E * om_e - t_d) / I_E
+        a_m, a_e = accelerations(z[4], phi, om_m, om_e, r_M * force)
         return np.array((z[1], g[1] - r_M * a_m, g[2], g[3], om_m, a_m, om_e - om_m, a_e))
 
     return rhs
