@@ -12,7 +12,7 @@ use std::ptr::null_mut;
 /// An instance of S1 in continuous-time mode at t = 0.
 fn continuous_s1(name: &str) -> Slave {
     let slave = Slave::of_type(name, fmi2Type_fmi2ModelExchange, false);
-    let (reals, integers) = s1_start(0.0);
+    let (reals, integers) = s1_start(30.0, 0.0);
     slave.initialise(1e-6, &reals, &integers);
     let mut info = fmi2EventInfo {
         newDiscreteStatesNeeded: 0,
@@ -125,7 +125,7 @@ fn a_time_beyond_the_sine_phase_is_refused() {
 fn a_state_of_the_other_interface_is_refused() {
     let me = continuous_s1("model exchange");
     let cs = Slave::new("co-simulation", false);
-    let (reals, integers) = s1_start(0.0);
+    let (reals, integers) = s1_start(30.0, 0.0);
     cs.initialise(1e-6, &reals, &integers);
     let mut state = null_mut();
     unsafe {
