@@ -636,16 +636,15 @@ impl Slave for Instance {
             )));
         }
         let sim = self.model_exchange();
-        let before = sim.t;
+        let before = sim.clone();
         sim.set_time(t);
         // The shaft's angle and speed, which fmi2SetContinuousStates needs, overflow only
-        // where the sine's phase does (the torque mode's are states, the inputs mode's held
-        // inputs): then setting the time back restores all.
+        // where the sine's phase does: then the simulation is put back as it was.
         let shaft = sim.shaft();
         if shaft.theta.is_finite() && shaft.omega.is_finite() {
             return Ok(());
         }
-        sim.set_time(before);
+        *sim = before;
         Err(FmiError::error(format!(
             "time = {t:e} refused: the main shaft's motion there is not finite ({shaft:?}), beyond what the model can represent"
         )))
