@@ -111,6 +111,7 @@ fn a_time_beyond_the_sine_phase_is_refused() {
         "{}",
         last.message
     );
+    assert_eq!(states(&slave), x, "a refused time changes no state");
     set_states(&slave, &x);
     assert_eq!(states(&slave), x, "the states read back as set, at t = 0");
     ok(&slave, "fmi2SetTime", unsafe {

@@ -635,19 +635,11 @@ impl Slave for Instance {
                 "time = {t} refused: it must be finite"
             )));
         }
-        let sim = self.model_exchange();
-        let before = sim.clone();
-        sim.set_time(t);
-        // The shaft's angle and speed, which fmi2SetContinuousStates needs, overflow only
-        // where the sine's phase does: then the simulation is put back as it was.
-        let shaft = sim.shaft();
-        if shaft.theta.is_finite() && shaft.omega.is_finite() {
-            return Ok(());
-        }
-        *sim = before;
-        Err(FmiError::error(format!(
-            "time = {t:e} refused: the main shaft's motion there is not finite ({shaft:?}), beyond what the model can represent"
-        )))
+        self.model_exchange().set_time(t).map_err(|shaft| {
+            FmiError::error(format!(
+                "time = {t:e} refused: the main shaft's motion there is not finite ({shaft:?}), beyond what the model can represent"
+            ))
+        })
     }
 
     fn set_continuous_states(&mut self, x: &[f64]) -> FmiResult {

@@ -182,12 +182,20 @@ impl Simulation {
 
     /// The importer's time. In the inputs mode the shaft's inputs hold until set again. The
     /// states x stay as set: in the sine mode the shaft's speed moves with t, so ξ' is
-    /// recomputed from ω_L.
-    pub fn set_time(&mut self, t: f64) {
-        let x = self.continuous_states();
+    /// recomputed from ω_L. A time where the shaft's motion is not finite (where the sine's
+    /// phase overflows) is refused with that motion, and nothing changes.
+    pub fn set_time(&mut self, t: f64) -> Result<(), Shaft> {
+        let (x, before) = (self.continuous_states(), self.t);
         self.t = t;
         self.hold_inputs();
+        let shaft = self.shaft();
+        if !(shaft.theta.is_finite() && shaft.omega.is_finite()) {
+            self.t = before;
+            self.hold_inputs();
+            return Err(shaft);
+        }
         self.set_continuous_states(&x);
+        Ok(())
     }
 
     /// New shaft inputs (inputs mode) as the importer sets them: unlike co-simulation's

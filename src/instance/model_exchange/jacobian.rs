@@ -239,7 +239,7 @@ mod tests {
             values.set_real(v, value);
         }
         let mut sim = Simulation::new(&values, 0.0, 0.0, 1e-6).expect("valid parameters");
-        sim.set_time(T);
+        sim.set_time(T).expect("a finite shaft at T");
         sim.set_shaft_inputs(shaft);
         sim.set_torque(tau, TAU.1);
         sim.set_continuous_states(x);
@@ -335,7 +335,7 @@ mod tests {
         let x = [3e-6, 64.0, 4.5, 83.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6];
         for excitation in [EXCITATION_INPUTS, EXCITATION_SINE, EXCITATION_TORQUE] {
             let mut sim = at(excitation, 1.0, &x, SHAFT, TAU.0);
-            sim.set_time(T + 1e-3);
+            sim.set_time(T + 1e-3).expect("a finite shaft at T + 1 ms");
             sim.set_shaft_inputs(Shaft {
                 omega: 90.0,
                 ..SHAFT
