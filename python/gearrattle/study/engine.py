@@ -14,8 +14,8 @@ from .worker import FAILED, FMUPlugin, failed, install_fmu, run_batch
 from ..progress import Progress
 
 # The local cluster has no dashboard, so nothing reads its profiler's samples (every 10 ms in
-# each worker), the system monitor or the 20-ms event-loop tick: idle, they take about 8 % of
-# a core from the points on a machine whose cores the workers fill; 2 % without them.
+# each worker), the system monitor or the 20-ms event-loop tick: off, so that they take no CPU
+# from the points on a machine whose cores the workers fill (docs/DECISIONS.md D30).
 QUIET_CLUSTER = {"distributed.worker.profile.enabled": False,
                  "distributed.admin.tick.interval": "1s",
                  "distributed.admin.system-monitor.interval": "1s"}
