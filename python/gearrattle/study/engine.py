@@ -10,7 +10,7 @@ import os
 
 from . import designs, results
 from .model import STATS_FROM
-from .worker import FAILED, FMUPlugin, failed, install_fmu, run_batch
+from .worker import FAILED, Batch, FMUPlugin, failed, install_fmu, run_batch
 from ..progress import Progress
 
 # The local cluster has no dashboard, so nothing reads its profiler's samples (every 10 ms in
@@ -21,6 +21,8 @@ QUIET_CLUSTER = {"distributed.worker.profile.enabled": False,
                  "distributed.admin.system-monitor.interval": "1s"}
 TASKS_PER_WORKER = 8  # batches per worker: balances the load and bounds what a lost worker costs
 BATCH_MAX = 100  # points per batch at most (about 0.3 s of work on one core)
+TAIL = 2  # towards the end a batch is at most 1/(TAIL * workers) of the points left ...
+TAIL_MIN = 8  # ... and at least 1/TAIL_MIN of the study's batch size
 
 
 class Plan:
@@ -38,14 +40,29 @@ class Plan:
         self.ids = [results.point_id(v, model.guid, st.duration) for v in self.values]
         self.schema = results.schema(self.param_names, model, st.record)
 
-    def row(self, index, worker_row):
-        """A complete result row: the worker's metrics and status with the point's values."""
-        return {**worker_row, **self.values[index], "point": index, "duration": self.st.duration,
-                "guid": self.model.guid, "point_id": self.ids[index]}
+    def batch(self, points):
+        """The points [(index, id, values)] as one batch of this study."""
+        return Batch(self.model.guid, self.st.duration, self.st.record, self.schema, points)
 
 
 def batch_size(n_points, n_workers):
     return max(1, min(BATCH_MAX, math.ceil(n_points / (TASKS_PER_WORKER * max(n_workers, 1)))))
+
+
+def batches(todo, n_workers):
+    """The points in batches of batch_size; with several workers the batches shrink towards
+    the end (guided self-scheduling) so that the workers run out of work together rather than
+    one batch apart."""
+    n = max(n_workers, 1)
+    size = batch_size(len(todo), n)
+    out, k = [], 0
+    while k < len(todo):
+        left = len(todo) - k
+        step = size if n == 1 else min(size, max(math.ceil(size / TAIL_MIN),
+                                                 math.ceil(left / (TAIL * n))))
+        out.append(todo[k:k + step])
+        k += step
+    return out
 
 
 def execute(st, model, fmu_bytes, quiet=False, points=None, session=None):
@@ -63,38 +80,30 @@ def execute(st, model, fmu_bytes, quiet=False, points=None, session=None):
     if not quiet and done:
         print(f"gearrattle-study: {len(plan.ids) - len(todo)} of {len(plan.ids)} points already "
               f"in {st.out}: running the other {len(todo)}", flush=True)
-    computed = {}
+    tables = []
     if todo:
         bar = None if quiet else Progress(len(todo), f"{st.kind} study")
 
-        def store_batch(rows):
-            full = [plan.row(r["point"], r) for r in rows]
-            store.append(full, plan.schema)
-            computed.update((r["point_id"], r) for r in full)
+        def store_batch(table):
+            store.append(table)
+            tables.append(table)
             if bar:
-                refused = sum(r["status"] != "ok" for r in full)
-                bar.update(len(full), f"{refused} refused" if refused else "")
+                refused = table.num_rows - table["status"].to_pylist().count("ok")
+                bar.update(table.num_rows, f"{refused} refused" if refused else "")
 
         if session is None:
             with Session(st, model, fmu_bytes) as own:
-                own.run(st, todo, store_batch)
+                own.run(plan, todo, store_batch)
         else:
-            session.run(st, todo, store_batch)
+            session.run(plan, todo, store_batch)
         if bar:
             bar.close()
-    rows = [dict(done.get(pid) or computed[pid]) for pid in plan.ids]
-    for i, r in enumerate(rows):  # a stored point may sit at another index in this design
-        r["point"] = i
-    return store.consolidate(rows, plan.schema)
+    return store.consolidate(plan.ids, list(done.values()), tables, plan.schema)
 
 
 def _key(batch):
-    return "gearrattle-batch-" + hashlib.sha256("".join(p for _, p, _ in batch).encode()
+    return "gearrattle-batch-" + hashlib.sha256("".join(p for _, p, _ in batch.points).encode()
                                                 ).hexdigest()[:24]
-
-
-def _batches(todo, size):
-    return [todo[k:k + size] for k in range(0, len(todo), size)]
 
 
 class Session:
@@ -139,24 +148,22 @@ class Session:
     def workers(self):
         return 1 if self.client is None else max(len(self.client.scheduler_info()["workers"]), 1)
 
-    def run(self, st, todo, store_batch):
-        """Run the points [(index, id, values)] in batches; store_batch(rows) as each ends."""
-        record = tuple(st.record)
-        batches = _batches(todo, batch_size(len(todo), self.workers()))
+    def run(self, plan, todo, store_batch):
+        """Run the points [(index, id, values)] in batches; store_batch(table) as each ends."""
+        batched = [plan.batch(b) for b in batches(todo, self.workers())]
         if self.client is None:
-            for b in batches:
-                store_batch(run_batch(self.model.guid, st.duration, record, b))
+            for b in batched:
+                store_batch(run_batch(b))
             return
         from distributed import as_completed
 
         # a batch's key names its points: the same key on a shared cluster is the same work
-        futures = {self.client.submit(run_batch, self.model.guid, st.duration, record, b,
-                                      pure=False, key=_key(b)): b for b in batches}
+        futures = {self.client.submit(run_batch, b, pure=False, key=_key(b)): b for b in batched}
         for fut in as_completed(futures):
             try:
-                rows = fut.result()
+                table = fut.result()
             except Exception as e:  # noqa: BLE001 (e.g. KilledWorker: the batch killed its
                 # workers again and again); its points are recorded, not dropped
-                rows = [{**failed(f"{type(e).__name__}: {e}"), "point": i, "point_id": pid}
-                        for i, pid, _ in futures[fut]]
-            store_batch(rows)
+                b = futures[fut]
+                table = b.table([failed(f"{type(e).__name__}: {e}")] * len(b.points))
+            store_batch(table)

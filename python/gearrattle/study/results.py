@@ -38,22 +38,26 @@ class Store:
                         rows[r["point_id"]] = r  # a point run again after failing
         return rows
 
-    def append(self, rows, schema):
-        """Write a batch's rows as one new file (atomically: a crash leaves no half file)."""
-        import pyarrow as pa
+    def append(self, table):
+        """Write a batch's table as one new file (atomically: a crash leaves no half file)."""
         import pyarrow.parquet as pq
 
         path = os.path.join(self.partial, f"{uuid.uuid4().hex}.parquet")
-        pq.write_table(pa.Table.from_pylist(rows, schema=schema), path + ".tmp")
+        pq.write_table(table, path + ".tmp")
         os.replace(path + ".tmp", path)
 
-    def consolidate(self, rows, schema):
-        """points.parquet and points.csv from the rows, sorted by point index."""
+    def consolidate(self, ids, done, tables, schema):
+        """points.parquet and points.csv: for each point id of the design in order, its row from
+        the rows already stored (done) or from the tables computed now."""
         import pyarrow as pa
         import pyarrow.csv as pcsv
         import pyarrow.parquet as pq
 
-        table = pa.Table.from_pylist(sorted(rows, key=lambda r: r["point"]), schema=schema)
+        every = pa.concat_tables([pa.Table.from_pylist(done, schema=schema), *tables])
+        at = {pid: k for k, pid in enumerate(every["point_id"].to_pylist())}
+        table = every.take([at[pid] for pid in ids])
+        # a stored point may sit at another index in this design
+        table = table.set_column(0, "point", pa.array(range(len(ids)), pa.int64()))
         pq.write_table(table, os.path.join(self.out, "points.parquet"))
         pcsv.write_csv(table, os.path.join(self.out, "points.csv"))
         return table

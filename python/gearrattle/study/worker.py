@@ -205,22 +205,42 @@ def drop_instance(guid):
         _LOGS.pop(inst.name, None)
 
 
-def run_batch(guid, duration, record, points):
-    """Run a batch of points [(point index, point id, {name: value})] on this thread's instance.
-    Returns one row (a dict) per point, in order."""
+class Batch:
+    """A batch of points [(point index, point id, {name: value})] with what its rows need: one
+    opaque task argument, so that Dask does not walk through its points looking for futures."""
+
+    __slots__ = ("guid", "duration", "record", "schema", "points")
+
+    def __init__(self, guid, duration, record, schema, points):
+        self.guid, self.duration, self.record = guid, duration, tuple(record)
+        self.schema, self.points = schema, points
+
+    def table(self, rows):
+        """The points' result rows (metrics and status, in order) completed with each point's
+        values and identity, as one Arrow table of the study's schema."""
+        import pyarrow as pa
+
+        return pa.Table.from_pylist(
+            [{**row, **values, "point": index, "duration": self.duration, "guid": self.guid,
+              "point_id": pid} for row, (index, pid, values) in zip(rows, self.points)],
+            schema=self.schema)
+
+
+def run_batch(batch):
+    """Run a batch on this thread's instance: its rows as an Arrow table, built here so that the
+    client only stores it."""
     rows = []
-    for index, pid, values in points:
+    for _, _, values in batch.points:
         try:
-            row = instance(guid).run(values, duration, record)
+            row = instance(batch.guid).run(values, batch.duration, batch.record)
         except _Fatal as e:
-            drop_instance(guid)
+            drop_instance(batch.guid)
             row = {**e.row, "cpu_s": float("nan")}
         except Exception as e:  # noqa: BLE001 (the instance's state is unknown: a new one)
-            drop_instance(guid)
+            drop_instance(batch.guid)
             row = failed(f"{type(e).__name__}: {e}")
-        row.update(point=index, point_id=pid)
         rows.append(row)
-    return rows
+    return batch.table(rows)
 
 
 def failed(message):
@@ -229,7 +249,6 @@ def failed(message):
 
 
 FAILED = "failed"
-
 
 
 class FMUPlugin(WorkerPlugin):
