@@ -5,7 +5,7 @@
 //! Exchange state derivative with the states and inputs its `depends_on` names.
 
 use fmi2_shell::values::Values;
-use gear_rattle::contract::{Causality, Kind, VARIABLES, Variable, vr};
+use gear_rattle::contract::{Causality, Kind, STATES, VARIABLES, Variable, vr};
 use gear_rattle::instance::Simulation;
 use gear_rattle::instance::model_exchange::column;
 use std::collections::BTreeSet;
@@ -37,6 +37,8 @@ fn outputs(kind: Kind) -> impl Iterator<Item = &'static Variable> {
 }
 
 const COUPLINGS: [i64; 3] = [0, 1, 2];
+/// ξ / G at the start: in each region of the contact law (both contacts, both bands, the gap).
+const GAP_STARTS: [f64; 5] = [-0.2, -0.02, 0.5, 1.02, 1.2];
 
 #[test]
 fn every_output_is_computed_in_every_coupling() {
@@ -80,11 +82,14 @@ fn derivatives_are_given_exactly_where_the_contract_says() {
 /// counts an impact at once): `depends_on` names the inputs, their partials are zero.
 const PIECEWISE_CONSTANT: [u32; 1] = [vr::impact_speed];
 
-/// ∂output/∂input is non-zero, in the coupling that uses the input, exactly for the inputs
-/// of `depends_on` (θ_M, ω_M, α_M in the inputs mode; τ_in in the torque mode).
+/// An output moves at once with an input, in the coupling that uses the input, exactly for
+/// the inputs `depends_on` names (θ_M, ω_M, α_M in the inputs mode; τ_in in the torque mode):
+/// in co-simulation (∂output/∂input non-zero: ξ follows θ_M, θ_L holds) or in Model
+/// Exchange (the states held: θ_L follows θ_M).
 #[test]
 fn partials_are_non_zero_exactly_where_depends_on_says() {
     let (inputs_mode, torque_mode) = (in_contact(0), in_contact(2));
+    let mut model_exchange = model_exchange_points();
     let inputs: Vec<&Variable> = VARIABLES
         .iter()
         .filter(|v| v.causality == Causality::Input)
@@ -99,6 +104,8 @@ fn partials_are_non_zero_exactly_where_depends_on_says() {
                     &inputs_mode
                 };
                 sim.partial(v.vr, u.vr) != 0.0
+                    || SHAFT_INPUTS.contains(&u.vr)
+                        && model_exchange.iter_mut().any(|sim| moves(sim, v, u.vr))
             })
             .map(|u| u.name)
             .collect();
@@ -106,7 +113,12 @@ fn partials_are_non_zero_exactly_where_depends_on_says() {
             assert!(moved.is_empty() && !v.depends_on.is_empty(), "{}", v.name);
             continue;
         }
-        let mut declared = v.depends_on.to_vec();
+        let mut declared: Vec<&str> = v
+            .depends_on
+            .iter()
+            .copied()
+            .filter(|d| inputs.iter().any(|u| u.name == *d))
+            .collect();
         declared.sort_by_key(|name| inputs.iter().position(|u| u.name == *name));
         assert_eq!(
             moved, declared,
@@ -128,8 +140,7 @@ fn state_derivatives_move_exactly_with_what_depends_on_says() {
     let jacobians: Vec<_> = COUPLINGS
         .iter()
         .flat_map(|&excitation| {
-            [-0.2, -0.02, 0.5, 1.02, 1.2]
-                .map(|gap_start| starting_at(excitation, gap_start).jacobian())
+            GAP_STARTS.map(|gap_start| starting_at(excitation, gap_start).jacobian())
         })
         .collect();
     let derivatives = VARIABLES
@@ -153,4 +164,100 @@ fn state_derivatives_move_exactly_with_what_depends_on_says() {
             d.name
         );
     }
+}
+
+/// Model Exchange: an output moves when a continuous state is set to another value
+/// (fmi2SetContinuousStates), in some region of the contact law and some drive mode, with
+/// the statistics' window open, exactly for the states its `depends_on` names
+/// (ModelStructure/Outputs). Outputs that change at events only (the counters, the located
+/// extrema) name no state.
+#[test]
+fn outputs_move_exactly_with_the_states_depends_on_names() {
+    let name = |vr: u32| {
+        VARIABLES
+            .iter()
+            .find(|v| v.vr == vr && v.kind == Kind::Real)
+            .expect("a state")
+            .name
+    };
+    let mut sims = model_exchange_points();
+    let mut wrong = Vec::new();
+    for v in VARIABLES
+        .iter()
+        .filter(|v| v.causality == Causality::Output)
+    {
+        let moved: BTreeSet<&str> = STATES
+            .iter()
+            .filter(|&&k| sims.iter_mut().any(|sim| moves(sim, v, k)))
+            .map(|&k| name(k))
+            .collect();
+        let declared: BTreeSet<&str> = v
+            .depends_on
+            .iter()
+            .copied()
+            .filter(|d| STATES.iter().any(|&s| name(s) == *d))
+            .collect();
+        if moved != declared {
+            wrong.push(format!(
+                "{}: moves with {moved:?}, declared {declared:?}",
+                v.name
+            ));
+        }
+    }
+    assert!(
+        wrong.is_empty(),
+        "states the outputs move with:\n{}",
+        wrong.join("\n")
+    );
+}
+
+/// The inputs of the inputs mode, which Model Exchange's importer sets with the states held.
+const SHAFT_INPUTS: [u32; 3] = [vr::theta_M, vr::omega_M, vr::alpha_M];
+
+/// Model Exchange's points: in each coupling and region at the start with the time set on,
+/// and stepped on (non-zero integrals), the statistics' window open.
+fn model_exchange_points() -> Vec<Simulation> {
+    let mut sims = Vec::new();
+    for excitation in COUPLINGS {
+        for gap_start in GAP_STARTS {
+            let mut set = starting_at(excitation, gap_start);
+            let mut stepped = starting_at(excitation, gap_start);
+            set.set_time(0.01).expect("a finite shaft");
+            stepped.step_to(0.01).expect("a step");
+            sims.extend([set, stepped]);
+        }
+    }
+    sims
+}
+
+/// Whether output v changes when a known (a state, or one of SHAFT_INPUTS) is moved by a small
+/// step relative to its value, as fmi2SetContinuousStates or fmi2SetReal do.
+fn moves(sim: &mut Simulation, v: &Variable, known: u32) -> bool {
+    let read = |sim: &Simulation| match v.kind {
+        Kind::Real => sim.real_output(v.vr).map(f64::to_bits),
+        _ => sim.integer_output(v.vr).map(|i| i as u64),
+    };
+    let step = |value: f64| 1e-6 * value.abs().max(1e-6);
+    let (x, shaft, before) = (sim.continuous_states(), sim.shaft(), read(sim));
+    if let Some(k) = STATES.iter().position(|&s| s == known) {
+        let mut moved = x;
+        moved[k] += step(x[k]);
+        sim.set_continuous_states(&moved);
+    } else {
+        let mut moved = shaft;
+        match known {
+            vr::theta_M => moved.theta += step(shaft.theta),
+            vr::omega_M => moved.omega += step(shaft.omega),
+            _ => moved.alpha += step(shaft.alpha),
+        }
+        sim.set_shaft_inputs(moved);
+    }
+    let after = read(sim);
+    if STATES.contains(&known) {
+        sim.set_continuous_states(&x);
+    } else {
+        sim.set_shaft_inputs(shaft);
+    }
+    assert_eq!(read(sim), before, "{}: known {known} set back", v.name);
+    before != after
 }

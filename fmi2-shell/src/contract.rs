@@ -42,7 +42,8 @@ pub struct Variable {
     pub start: Start,
     /// SI unit as named in UnitDefinitions ("" for dimensionless).
     pub unit: &'static str,
-    /// Outputs: the inputs it depends on at once (ModelStructure's dependencies).
+    /// Outputs and state derivatives: the inputs and continuous states it depends on at once
+    /// (ModelStructure's dependencies).
     pub depends_on: &'static [&'static str],
     /// Outputs: whether fmi2GetRealOutputDerivatives gives its first derivative.
     pub derivative: bool,
