@@ -616,9 +616,8 @@ impl Slave for Instance {
                 directional(unknowns, dv_known, dv_unknown, |var| {
                     let gradient = jacobian.gradient(var.vr).ok_or_else(|| {
                         FmiError::error(format!(
-                            "{} is not an unknown of Model Exchange's directional derivatives: they are given for the state derivatives der(...) and the outputs {}",
-                            var.name,
-                            jacobian.outputs().collect::<Vec<_>>().join(", ")
+                            "{} is not an unknown of Model Exchange's directional derivatives: they are given for the state derivatives der(...) and the Real outputs",
+                            var.name
                         ))
                     })?;
                     Ok(columns.iter().map(|&c| gradient.0[c]).collect())

@@ -158,7 +158,8 @@ impl Simulation {
     /// ∂ẋ/∂(x, u) and the outputs' partials at the current time and states
     /// (fmi2GetDirectionalDerivative; see [`Jacobian`]).
     pub fn jacobian(&self) -> Jacobian {
-        Jacobian::new(&self.point())
+        let now = self.now();
+        Jacobian::new(&self.point(), now.window.slopes(self.t, &now.quadratures))
     }
 
     /// The event indicators: ξ against the contact law's four edges, and in the gap ξ' (1

@@ -79,6 +79,17 @@ pub struct Metrics {
     pub P_lubricant: f64,
 }
 
+/// ∂/∂q of the window's figures that move with the quadratures (Model Exchange's
+/// directional derivatives): a row over the quadratures for each. The other figures change
+/// at events only.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Slopes {
+    pub a_rms: Quadratures,
+    pub F_std: Quadratures,
+    pub P_contact: Quadratures,
+    pub P_lubricant: Quadratures,
+}
+
 impl Window {
     /// A window opening at `from` for a pair that starts at t0 in `region`.
     pub fn new(from: f64, t0: f64, region: Region) -> Self {
@@ -188,6 +199,30 @@ impl Window {
             P_contact: per_second(E_CONTACT),
             P_lubricant: per_second(E_LUBRICANT),
         }
+    }
+
+    /// The slopes of [`Window::metrics`] at t: with Δq = q − q(from) and T = t − from,
+    /// ∂(√(Δq_a²/T))/∂q_a² = 1 / (2 T a_rms), ∂F_std/∂q_F² = 1 / (2 T F_std),
+    /// ∂F_std/∂q_F = −F_mean / (T F_std), ∂P/∂q_E = 1 / T. Zero before the window opens, and
+    /// where a root is zero (its slope is infinite there; the figure is held at 0).
+    pub fn slopes(&self, t: f64, q: &Quadratures) -> Slopes {
+        use quadrature::*;
+        let m = self.metrics(t, q, 1.0);
+        let mut s = Slopes::default();
+        let (Some(q0), true) = (self.opened, m.length > 0.0) else {
+            return s;
+        };
+        let length = m.length;
+        if m.a_rms > 0.0 {
+            s.a_rms[A2] = 0.5 / (length * m.a_rms);
+        }
+        if m.F_std > 0.0 {
+            s.F_std[F2] = 0.5 / (length * m.F_std);
+            s.F_std[F1] = -(q[F1] - q0[F1]) / (length * length * m.F_std);
+        }
+        s.P_contact[E_CONTACT] = 1.0 / length;
+        s.P_lubricant[E_LUBRICANT] = 1.0 / length;
+        s
     }
 }
 

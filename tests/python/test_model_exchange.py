@@ -232,7 +232,11 @@ def agree(exact, fd, scale, h):
     return np.abs(exact - fd) <= tol
 
 
-OUTPUTS_CHECKED = ["theta_L", "omega_L", "alpha_L", "a_pitch_L", "xi_dot", "F_contact", "tau_M", "omega_M_out"]
+OUTPUTS_CHECKED = ["theta_L", "omega_L", "alpha_L", "a_pitch_L", "xi_dot", "F_contact", "tau_M", "omega_M_out",
+                   "stat_a_rms", "stat_F_std", "stat_P_contact", "stat_P_lubricant", "stat_v_mean_Fplus"]
+# The quadratures (E_contact, E_lubricant, W_shaft, ∫a², ∫F, ∫F²) at the point: the window's
+# statistics non-zero, ∫F² above (∫F)²/t for a positive variance of F.
+QUADRATURES = [0.1, 0.2, 0.3, 0.4, 0.5, 30.0]
 
 
 @pytest.mark.parametrize("mode", MODES)
@@ -252,6 +256,7 @@ def test_directional_derivative_matches_differences_of_derivatives(unzipdir, mod
         for xi in XIS:
             x = rhs.states_now()
             x[0] = xi
+            x[-len(QUADRATURES):] = QUADRATURES
             rhs.set(t, x)
             settle(fmu)
 
@@ -329,7 +334,7 @@ def test_directional_derivative_refuses_misuse(unzipdir, model_description, mode
     assert directional(vrs["der(xi)"], vrs["I_L"]) == fmi2Error  # a parameter
     assert directional(vrs["der(xi)"], vrs["F_contact"]) == fmi2Error  # an output, not a state
     assert directional(vrs["x_theta_M"], vrs["omega_L"]) == fmi2Error  # a state, not a derivative
-    assert directional(vrs["stat_a_rms"], vrs["omega_L"]) == fmi2Error  # an output not given
+    assert directional(vrs["I_L"], vrs["omega_L"]) == fmi2Error  # a parameter as unknown
     assert directional(vrs["der(xi)"], vrs["omega_L"], float("nan")) == fmi2Error
     assert directional(vrs["der(xi)"], vrs["omega_L"], 2.0) == fmi2OK
     assert out[0] == pytest.approx(2 * R.DEFAULTS["r_L"], rel=1e-15)
