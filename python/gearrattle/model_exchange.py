@@ -216,8 +216,8 @@ class Cost:
     steps: int  # accepted steps (cut at events included)
     events: int  # event iterations (state, time and step events)
     # The solver's Jacobian evaluations: Drivetrain.jac's (nx + 2 fmi2GetDirectionalDerivative
-    # calls each) with the Jacobian, else the solver's differences (nx + 4 right-hand sides
-    # each, counted in rhs too).
+    # calls each) with the Jacobian, else the solver's differences (at least nx + 4
+    # right-hand sides each, counted in rhs too).
     jacobians: int
 
 
@@ -234,7 +234,7 @@ def simulate(t_end: float, dt: float, rtol: float, method: str = "LSODA", gear_p
     rec.update({k: np.zeros(n + 1, dtype=np.int64) for k in MS.GEAR_COUNTS})
     rec["time"] = np.arange(n + 1) * dt
     solver_class = SOLVERS[method]
-    steps = events = jacobians = 0
+    steps = events = solver_njev = 0
     with Drivetrain(fmu, gear_params, pf) as dt_:
         nx = dt_.nx
 
@@ -271,16 +271,15 @@ def simulate(t_end: float, dt: float, rtol: float, method: str = "LSODA", gear_p
                 z = z1
                 if event or solver.status == "finished":
                     break
-            jacobians += getattr(solver, "njev", 0)
+            solver_njev += getattr(solver, "njev", 0)
             t, y = t1, y1
             if event and t < t_end:
                 y = dt_.event(t, y)
                 events += 1
                 counts = dt_.impact_counts()
                 z = dt_.indicators(t, y)
-        if jacobian:
-            jacobians = dt_.n_jacobians
-        cost = Cost(time.perf_counter() - started, dt_.n_rhs, dt_.n_indicators, steps, events, int(jacobians))
+        jacobians = dt_.n_jacobians if jacobian else int(solver_njev)
+        cost = Cost(time.perf_counter() - started, dt_.n_rhs, dt_.n_indicators, steps, events, jacobians)
     return rec, cost
 
 

@@ -14,7 +14,8 @@ State z = [xi, xi_dot, E_contact, E_lubricant, theta_M, omega_M, phi, omega_E]:
 * the drivetrain (partners/flywheel/src/model.rs, `drivetrain`): phi = theta_E - theta_M,
   T_d = k_d phi + c_d (omega_E - omega_M), I_M omega_M' = T_d + r_M F,
   I_E omega_E' = T_mean + T_2 sin(2 theta_E) - (T_mean / omega_idle) omega_E - T_d; the
-  Model Exchange master (model_exchange.py) puts the same function around GearRattle;
+  Model Exchange master (model_exchange.py) puts the same function around GearRattle, with
+  its partials (`drivetrain_partials`) in the master's Jacobian;
 * xi'' = r_L omega_L' - r_M omega_M'.
 """
 
