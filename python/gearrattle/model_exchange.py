@@ -13,7 +13,12 @@ tau_M depends on the states and on theta_M, omega_M, not on alpha_M (docs/MODEL_
 State vector y = [x (GearRattle's nx states, docs/MODEL_EXCHANGE.md), theta_M, omega_M, phi,
 omega_E], phi = theta_E - theta_M as in monolithic.py. One evaluation of the right-hand side
 is fmi2SetTime, fmi2SetReal(theta_M, omega_M), fmi2SetContinuousStates, fmi2GetDerivatives,
-fmi2GetReal(tau_M), then the drivetrain's accelerations.
+fmi2GetReal(tau_M), then the drivetrain's accelerations. The Jacobian of the whole state vector
+(`Drivetrain.jac`, passed to the solver unless `simulate(jacobian=False)`) is exact: the gear
+pair's block from fmi2GetDirectionalDerivative at the point set the same way, the
+drivetrain's from monolithic.drivetrain_partials, tau_M's partials entering the main shaft's
+acceleration by the chain rule; the implicit solvers then form no Jacobian by differences of
+the right-hand side.
 
 The solver is one of scipy's (LSODA by default: Adams in flight, BDF where the contact makes
 it stiff), stepped by hand so that the FMI 2.0 sequence is the importer's:
@@ -64,10 +69,11 @@ class Drivetrain:
         self.i_xi = next(i for i, d in enumerate(md.derivatives) if d.variable.derivative.name == "xi")
         pf = dict(M.FLYWHEEL) if pf is None else pf
         self.accelerations = M.drivetrain(pf)
+        self.partials = M.drivetrain_partials(pf)
         self._unzipdir = extract(str(fmu))
         self.fmu = FMU2Model(guid=md.guid, unzipDirectory=self._unzipdir,
                              modelIdentifier=md.modelExchange.modelIdentifier, instanceName="gear")
-        self.n_rhs = self.n_indicators = 0
+        self.n_rhs = self.n_indicators = self.n_jacobians = 0
         nx = self.nx
         self.nominals = np.concatenate((np.ones(nx), SHAFT_NOMINALS))  # the FMU's read at each event
         self._x, self._dx, self._z = np.zeros(nx), np.zeros(nx), np.zeros(self.nz)
@@ -77,6 +83,15 @@ class Drivetrain:
         self._vr_tau = (ctypes.c_uint * 1)(vr["tau_M"])
         self._vr_counts = (ctypes.c_uint * 2)(vr["impacts_Fplus"], vr["impacts_Fminus"])
         self._shaft, self._tau, self._counts = (ctypes.c_double * 2)(), (ctypes.c_double * 1)(), (ctypes.c_int * 2)()
+        # fmi2GetDirectionalDerivative's arguments: unknowns der(x) and tau_M; one call per
+        # known (the states, then theta_M, omega_M) with a unit seed, its column written into
+        # a row of _columns.
+        self._vr_unknowns = (ctypes.c_uint * (nx + 1))(*(d.variable.valueReference for d in md.derivatives), vr["tau_M"])
+        knowns = [d.variable.derivative.valueReference for d in md.derivatives] + [vr["theta_M"], vr["omega_M"]]
+        self._vr_knowns = [(ctypes.c_uint * 1)(k) for k in knowns]
+        self._seed = (ctypes.c_double * 1)(1.0)
+        self._columns = np.zeros((nx + 2, nx + 1))
+        self._pcolumns = [ptr(row) for row in self._columns]
         f = self.fmu
         f.instantiate()
         try:
@@ -127,6 +142,26 @@ class Drivetrain:
         out = np.empty(nx + 4)
         out[:nx] = self._dx
         out[nx:] = (om_m, a_m, om_e - om_m, a_e)
+        return out
+
+    def jac(self, t: float, y: np.ndarray) -> np.ndarray:
+        """d rhs / d y at (t, y). Rows nx.. are theta_M' = omega_M, omega_M' = a_M,
+        phi' = omega_E - omega_M, omega_E' = a_E; a_M depends on x, theta_M and omega_M also
+        through tau_M."""
+        f, nx = self.fmu, self.nx
+        self._set(t, y)
+        for known, column in zip(self._vr_knowns, self._pcolumns):
+            f.fmi2GetDirectionalDerivative(f.component, self._vr_unknowns, nx + 1, known, 1, self._seed, column)
+        self.n_jacobians += 1
+        d_fmu = self._columns.T  # rows der(x), tau_M; columns x, theta_M, omega_M
+        d_shaft = self.partials(y[nx], y[nx + 2])  # rows a_M, a_E; columns theta_M, omega_M, phi, omega_E, tau_M
+        out = np.zeros((nx + 4, nx + 4))
+        out[:nx, : nx + 2] = d_fmu[:nx]
+        out[nx, nx + 1] = 1.0
+        out[nx + 2, nx + 1], out[nx + 2, nx + 3] = -1.0, 1.0
+        accelerations = [nx + 1, nx + 3]
+        out[accelerations, nx:] = d_shaft[:, :4]
+        out[accelerations, : nx + 2] += np.outer(d_shaft[:, 4], d_fmu[nx])
         return out
 
     def indicators(self, t: float, y: np.ndarray) -> np.ndarray:
@@ -180,22 +215,26 @@ class Cost:
     indicators: int  # fmi2GetEventIndicators calls (step ends and event location)
     steps: int  # accepted steps (cut at events included)
     events: int  # event iterations (state, time and step events)
-    jacobians: int  # the solver's Jacobian evaluations (by differences of the right-hand side)
+    # The solver's Jacobian evaluations: Drivetrain.jac's (nx + 2 fmi2GetDirectionalDerivative
+    # calls each) with the Jacobian, else the solver's differences (at least nx + 4
+    # right-hand sides each, counted in rhs too).
+    jacobians: int
 
 
 def simulate(t_end: float, dt: float, rtol: float, method: str = "LSODA", gear_params: dict | None = None,
-             pf: dict | None = None, fmu=MS.GEAR_FMU) -> tuple[dict, Cost]:
+             pf: dict | None = None, fmu=MS.GEAR_FMU, jacobian: bool = True) -> tuple[dict, Cost]:
     """The drivetrain from its initial state to t_end, sampled at t_n = n dt on the solver's
     dense output: a record with the fields time, theta_M, omega_M, xi, impacts_Fplus,
     impacts_Fminus (those of masters.py's records that Model Exchange has), and the cost.
-    Absolute tolerances rtol times the nominal of each state."""
+    Absolute tolerances rtol times the nominal of each state. With `jacobian` the solver gets
+    Drivetrain.jac; without, it forms its Jacobians by differences of the right-hand side."""
     started = time.perf_counter()
     n = MS._steps(t_end, dt)
     rec = {k: np.zeros(n + 1) for k in ("time", "theta_M", "omega_M", "xi")}
     rec.update({k: np.zeros(n + 1, dtype=np.int64) for k in MS.GEAR_COUNTS})
     rec["time"] = np.arange(n + 1) * dt
     solver_class = SOLVERS[method]
-    steps = events = jacobians = 0
+    steps = events = solver_njev = 0
     with Drivetrain(fmu, gear_params, pf) as dt_:
         nx = dt_.nx
 
@@ -209,7 +248,8 @@ def simulate(t_end: float, dt: float, rtol: float, method: str = "LSODA", gear_p
         k = 1
         z = dt_.indicators(t, y)
         while t < t_end:
-            solver = solver_class(dt_.rhs, t, y, min(t_end, dt_.next_time_event), rtol=rtol, atol=rtol * dt_.nominals)
+            solver = solver_class(dt_.rhs, t, y, min(t_end, dt_.next_time_event), rtol=rtol, atol=rtol * dt_.nominals,
+                                  jac=dt_.jac if jacobian else None)
             while True:
                 t0 = solver.t
                 if solver.step() is not None or solver.status == "failed":
@@ -231,14 +271,15 @@ def simulate(t_end: float, dt: float, rtol: float, method: str = "LSODA", gear_p
                 z = z1
                 if event or solver.status == "finished":
                     break
-            jacobians += getattr(solver, "njev", 0)
+            solver_njev += getattr(solver, "njev", 0)
             t, y = t1, y1
             if event and t < t_end:
                 y = dt_.event(t, y)
                 events += 1
                 counts = dt_.impact_counts()
                 z = dt_.indicators(t, y)
-        cost = Cost(time.perf_counter() - started, dt_.n_rhs, dt_.n_indicators, steps, events, int(jacobians))
+        jacobians = dt_.n_jacobians if jacobian else int(solver_njev)
+        cost = Cost(time.perf_counter() - started, dt_.n_rhs, dt_.n_indicators, steps, events, jacobians)
     return rec, cost
 
 

@@ -14,7 +14,8 @@ State z = [xi, xi_dot, E_contact, E_lubricant, theta_M, omega_M, phi, omega_E]:
 * the drivetrain (partners/flywheel/src/model.rs, `drivetrain`): phi = theta_E - theta_M,
   T_d = k_d phi + c_d (omega_E - omega_M), I_M omega_M' = T_d + r_M F,
   I_E omega_E' = T_mean + T_2 sin(2 theta_E) - (T_mean / omega_idle) omega_E - T_d; the
-  Model Exchange master (model_exchange.py) puts the same function around GearRattle;
+  Model Exchange master (model_exchange.py) puts the same function around GearRattle, with
+  its partials (`drivetrain_partials`) in the master's Jacobian;
 * xi'' = r_L omega_L' - r_M omega_M'.
 """
 
@@ -83,14 +84,19 @@ def gear_params(**overrides) -> dict:
     return R.params(**{**GEAR, **overrides})
 
 
+def _flywheel(pf: dict) -> tuple:
+    """(I_E, I_M, k_d, c_d, T_mean, T_2, d_E), d_E = T_mean / omega_idle the engine's
+    speed-proportional loss."""
+    return (*(pf[k] for k in ("I_E", "I_M", "k_d", "c_d", "T_mean", "T_2")), pf["T_mean"] / pf["omega_idle"])
+
+
 def drivetrain(pf: dict):
     """The Flywheel's equations (partners/flywheel/src/model.rs) as a function
     accelerations(theta_M, phi, omega_M, omega_E, tau_M) -> (omega_M', omega_E'), tau_M being
     the torque the gear pair exerts on the main shaft (r_M F): the clutch damper's
     T_d = k_d phi + c_d (omega_E - omega_M), I_M omega_M' = T_d + tau_M,
     I_E omega_E' = T_mean + T_2 sin(2 theta_E) - (T_mean / omega_idle) omega_E - T_d."""
-    I_E, I_M, k_d, c_d, T_mean, T_2 = (pf[k] for k in ("I_E", "I_M", "k_d", "c_d", "T_mean", "T_2"))
-    d_E = T_mean / pf["omega_idle"]
+    I_E, I_M, k_d, c_d, T_mean, T_2, d_E = _flywheel(pf)
     sin = math.sin
 
     def accelerations(theta_M, phi, om_m, om_e, tau_M):
@@ -98,6 +104,29 @@ def drivetrain(pf: dict):
         return (t_d + tau_M) / I_M, (T_mean + T_2 * sin(2.0 * (theta_M + phi)) - d_E * om_e - t_d) / I_E
 
     return accelerations
+
+
+def drivetrain_partials(pf: dict):
+    """The partials of `drivetrain`'s accelerations as a function partials(theta_M, phi) ->
+    a (2, 5) array: rows omega_M', omega_E'; columns theta_M, omega_M, phi, omega_E, tau_M
+    (the order of the master's state vector, then the gear pair's torque, through which a
+    caller adds tau_M's own partials by the chain rule). Only the engine's firing torque
+    T_2 sin(2 (theta_M + phi)) is nonlinear; the rest is constant."""
+    I_E, I_M, k_d, c_d, _, T_2, d_E = _flywheel(pf)
+    const = np.array([
+        [0.0, -c_d / I_M, k_d / I_M, c_d / I_M, 1.0 / I_M],
+        [0.0, c_d / I_E, -k_d / I_E, -(d_E + c_d) / I_E, 0.0],
+    ])
+    cos = math.cos
+
+    def partials(theta_M, phi):
+        out = const.copy()
+        firing = 2.0 * T_2 * cos(2.0 * (theta_M + phi)) / I_E
+        out[1, 0] = firing
+        out[1, 2] += firing
+        return out
+
+    return partials
 
 
 def _coupled_rhs(pg: dict, pf: dict, code: int):
