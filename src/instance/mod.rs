@@ -100,14 +100,24 @@ impl Instance {
         ))
     }
 
+    /// A Real output of the running simulation as the interface reads it (Model Exchange:
+    /// the contact in the region ξ is in, as the derivatives).
+    fn output(sim: &Simulation, interface: Interface, vr: u32) -> Option<f64> {
+        match interface {
+            Interface::CoSimulation => sim.real_output(vr),
+            Interface::ModelExchange => sim.model_exchange_output(vr),
+        }
+    }
+
     /// A Real variable's value by its contract entry (a parameter, an input, or an output of
     /// the simulation built from the values so far).
     fn real_value(&mut self, vr: u32) -> FmiResult<f64> {
         Ok(match contract::variable(Kind::Real, vr)?.causality {
-            Causality::Output | Causality::Local => self
-                .current()?
-                .real_output(vr)
-                .expect("every computed Real variable of the contract is computed"),
+            Causality::Output | Causality::Local => {
+                let interface = self.interface;
+                Self::output(self.current()?, interface, vr)
+                    .expect("every computed Real variable of the contract is computed")
+            }
             _ => self.values.real(vr),
         })
     }
@@ -414,7 +424,11 @@ impl Slave for Instance {
     fn get_real(&mut self, vrs: &[u32], out: &mut [f64]) -> FmiResult {
         for (vr, out) in vrs.iter().zip(out) {
             // An output of the running simulation first: what a master reads after each step.
-            *out = match self.sim.as_ref().and_then(|sim| sim.real_output(*vr)) {
+            let output = self
+                .sim
+                .as_ref()
+                .and_then(|sim| Self::output(sim, self.interface, *vr));
+            *out = match output {
                 Some(value) => value,
                 None => self.real_value(*vr)?,
             };

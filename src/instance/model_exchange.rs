@@ -243,6 +243,17 @@ impl Simulation {
         }
     }
 
+    /// A Real output as Model Exchange reads it: the contact's loads, and the torque mode's
+    /// shaft acceleration, in the region ξ is in, as the derivatives and the Jacobian take
+    /// them (the region kept since the last event gives another force between an edge
+    /// crossing and the importer's event there).
+    pub fn model_exchange_output(&self, vr: u32) -> Option<f64> {
+        self.real_output_with(vr, &self.now(), || {
+            let point = self.point();
+            (point.shaft, point.loads)
+        })
+    }
+
     /// The Model Exchange variables that are not outputs: the states θ_M and ω_M of the
     /// torque mode, the quadratures W_shaft, ∫a², ∫F, ∫F², and the derivatives.
     pub fn model_exchange_local(&self, vr: u32) -> Option<f64> {

@@ -12,7 +12,7 @@ use super::{FmiError, FmiResult};
 use crate::contract::vr;
 use crate::integrator::{Jacobian, Method, Piecewise, Solver, SolverError, Stats};
 use crate::physics::{
-    Dynamics, Excitation, GearParams, MainShaft, Polynomial, Region, Shaft, Sine, TorqueRamp,
+    Dynamics, Excitation, GearParams, Loads, MainShaft, Polynomial, Region, Shaft, Sine, TorqueRamp,
 };
 use crate::rattle::torque::{self, TorqueRattle};
 use crate::rattle::window::{Metrics, Quadratures, Window, quadrature};
@@ -138,7 +138,7 @@ pub(super) struct Now<'a> {
 }
 
 impl Now<'_> {
-    pub(super) fn loads(&self, shaft: &Shaft) -> crate::physics::Loads {
+    pub(super) fn loads(&self, shaft: &Shaft) -> Loads {
         self.dynamics
             .loads(self.region, self.xi, self.xi_dot, shaft)
     }
@@ -390,9 +390,23 @@ impl Simulation {
     /// The value of a Real output, computed now; None if `vr` is not a Real output.
     pub fn real_output(&self, vr: u32) -> Option<f64> {
         let now = self.now();
+        self.real_output_with(vr, &now, || {
+            let shaft = self.shaft();
+            (shaft, now.loads(&shaft))
+        })
+    }
+
+    /// A Real output with the shaft's motion and the loads from `motion` (the contact law's
+    /// region kept by the integrator, or in Model Exchange the one ξ is in).
+    pub(super) fn real_output_with(
+        &self,
+        vr: u32,
+        now: &Now,
+        motion: impl Fn() -> (Shaft, Loads),
+    ) -> Option<f64> {
         let dynamics = now.dynamics;
-        let shaft = || self.shaft();
-        let loads = || now.loads(&shaft());
+        let shaft = || motion().0;
+        let loads = || motion().1;
         Some(match vr {
             vr::theta_L => dynamics.theta_L(now.xi, &shaft()),
             vr::omega_L => loads().omega_L,

@@ -343,6 +343,45 @@ mod tests {
         }
     }
 
+    /// Model Exchange's outputs take the contact in the region ξ is in, as the derivatives:
+    /// ξ set into contact from the gap, with no event yet, gives α_L = der(ω_L) and the force
+    /// and τ_M that equation of motion implies, F = (B − C (ω_L − ω_S) − I_L α_L) / r_L,
+    /// where the region kept since the last event (co-simulation's outputs) still reads the
+    /// gap's zero force.
+    #[test]
+    fn outputs_take_the_region_xi_is_in() {
+        let gap = [10e-6, 64.0, 4.5, 83.0, 0.1, 0.2, 0.3, 0.4, 0.5, 30.0];
+        for excitation in [EXCITATION_INPUTS, EXCITATION_SINE, EXCITATION_TORQUE] {
+            let mut sim = at(excitation, 4.0 / 3.0, &gap, SHAFT, TAU.0);
+            let mut x = gap;
+            x[X_XI] = -3e-6;
+            sim.set_continuous_states(&x);
+            let p = sim.now().dynamics.params;
+            let alpha_L = sim.derivatives()[X_OMEGA_L];
+            let force = (p.B - p.C * (x[X_OMEGA_L] - p.omega_S) - p.I_L * alpha_L) / p.r_L;
+            let read = |vr| sim.model_exchange_output(vr).expect("an output");
+            assert!(
+                force.abs() > 1.0,
+                "mode {excitation}: in contact, F = {force}"
+            );
+            assert_eq!(read(vr::alpha_L), alpha_L, "mode {excitation}");
+            let tol = 1e-9 * force.abs();
+            assert!(
+                (read(vr::F_contact) - force).abs() <= tol,
+                "mode {excitation}"
+            );
+            assert!(
+                (read(vr::tau_M) - p.r_M * force).abs() <= p.r_M * tol,
+                "mode {excitation}"
+            );
+            assert_eq!(
+                sim.real_output(vr::F_contact),
+                Some(0.0),
+                "mode {excitation}"
+            );
+        }
+    }
+
     /// The Jacobian's columns hold x fixed, as FMI's states are: a new time (sine mode: the
     /// shaft's speed moves) or new inputs leave fmi2GetContinuousStates as set, to rounding.
     #[test]
