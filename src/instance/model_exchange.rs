@@ -248,10 +248,12 @@ impl Simulation {
     /// them (the region kept since the last event gives another force between an edge
     /// crossing and the importer's event there).
     pub fn model_exchange_output(&self, vr: u32) -> Option<f64> {
-        self.real_output_with(vr, &self.now(), || {
-            let point = self.point();
-            (point.shaft, point.loads)
-        })
+        self.real_output_with(
+            vr,
+            &self.now(),
+            || self.point().shaft,
+            || self.point().loads,
+        )
     }
 
     /// The Model Exchange variables that are not outputs: the states θ_M and ω_M of the

@@ -390,23 +390,20 @@ impl Simulation {
     /// The value of a Real output, computed now; None if `vr` is not a Real output.
     pub fn real_output(&self, vr: u32) -> Option<f64> {
         let now = self.now();
-        self.real_output_with(vr, &now, || {
-            let shaft = self.shaft();
-            (shaft, now.loads(&shaft))
-        })
+        self.real_output_with(vr, &now, || self.shaft(), || now.loads(&self.shaft()))
     }
 
-    /// A Real output with the shaft's motion and the loads from `motion` (the contact law's
-    /// region kept by the integrator, or in Model Exchange the one ξ is in).
+    /// A Real output with the shaft's motion and the loads from `shaft` and `loads`, each
+    /// computed only for the outputs that need it (the contact law's region kept by the
+    /// integrator, or in Model Exchange the one ξ is in).
     pub(super) fn real_output_with(
         &self,
         vr: u32,
         now: &Now,
-        motion: impl Fn() -> (Shaft, Loads),
+        shaft: impl Fn() -> Shaft,
+        loads: impl Fn() -> Loads,
     ) -> Option<f64> {
         let dynamics = now.dynamics;
-        let shaft = || motion().0;
-        let loads = || motion().1;
         Some(match vr {
             vr::theta_L => dynamics.theta_L(now.xi, &shaft()),
             vr::omega_L => loads().omega_L,

@@ -113,7 +113,7 @@ class Session:
 
     def __init__(self, st, model, fmu_bytes):
         self.st, self.model, self.data = st, model, fmu_bytes
-        self.client = self.cluster = self.plugin = self.config = None
+        self.client = self.cluster = self.plugin = None
 
     def __enter__(self):
         if self.st.workers == 0:
@@ -126,11 +126,12 @@ class Session:
             self.client = Client(self.st.scheduler, timeout="30s")
         else:
             n = self.st.workers or os.cpu_count() or 1
-            self.config = dask.config.set(QUIET_CLUSTER)  # its workers inherit it
-            # no dashboards (no port to find); the study reports its own errors
-            self.cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                                        dashboard_address=None, worker_dashboard_address=None,
-                                        silence_logs=logging.CRITICAL)
+            # no dashboards (no port to find); the study reports its own errors. The scheduler
+            # and the workers read QUIET_CLUSTER as they start.
+            with dask.config.set(QUIET_CLUSTER):
+                self.cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                                            dashboard_address=None, worker_dashboard_address=None,
+                                            silence_logs=logging.CRITICAL)
             self.client = Client(self.cluster)
         self.plugin = FMUPlugin(self.model.guid, self.data)
         self.client.register_plugin(self.plugin)
@@ -143,7 +144,6 @@ class Session:
             self.client.close()
         if self.cluster is not None:
             self.cluster.close(timeout=10)
-            self.config.__exit__(*exc)
 
     def workers(self):
         return 1 if self.client is None else max(len(self.client.scheduler_info()["workers"]), 1)

@@ -18,7 +18,7 @@
 use std::ops::{Add, Mul, Sub};
 
 use super::{NX, Point, ShaftFrom};
-use crate::contract::{Causality, DERIVATIVES, Kind, STATES, VARIABLES, vr};
+use crate::contract::{Causality, DERIVATIVES, Kind, STATES, find, vr};
 use crate::rattle::window::{Quadratures, Slopes, quadrature};
 
 /// The states' indices in x (the quadratures of [`quadrature`] follow from X_QUADRATURES on).
@@ -197,7 +197,9 @@ impl Jacobian {
             vr::stat_F_std => over_quadratures(&self.window.F_std),
             vr::stat_P_contact => over_quadratures(&self.window.P_contact),
             vr::stat_P_lubricant => over_quadratures(&self.window.P_lubricant),
-            _ if is_real_output(unknown) => Gradient::ZERO,
+            _ if find(Kind::Real, unknown).is_some_and(|v| v.causality == Causality::Output) => {
+                Gradient::ZERO
+            }
             _ => return None,
         })
     }
@@ -210,15 +212,10 @@ fn over_quadratures(row: &Quadratures) -> Gradient {
     g
 }
 
-fn is_real_output(vr: u32) -> bool {
-    VARIABLES
-        .iter()
-        .any(|v| v.vr == vr && v.causality == Causality::Output && v.kind == Kind::Real)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::contract::VARIABLES;
     use crate::instance::Simulation;
     use crate::instance::simulation::{EXCITATION_INPUTS, EXCITATION_SINE, EXCITATION_TORQUE};
     use crate::physics::{GearParams, Shaft};
