@@ -4,11 +4,10 @@
 # and every binary of the FMU stripped when packaged: the unstripped copies, with their line
 # tables, stay in target/fmu/debug/<platform>/ for debugging. tests/portable/check.sh checks
 # the packaged binaries (`make test-portable`, part of `make test`).
-# Installs what it needs when missing: zig (PyPI's ziglang, pinned in requirements.txt, into
-# the .venv), cargo-zigbuild (cargo install, pinned here), the rustup targets, and Debian's
-# llvm (llvm-strip, llvm-objdump, llvm-nm, llvm-lipo) with apt-get when root.
+# Installs what it needs when missing: zig and cargo-zigbuild (PyPI's prebuilt ziglang and
+# cargo-zigbuild wheels, pinned in requirements.txt, into the .venv), the rustup targets, and
+# Debian's llvm (llvm-strip, llvm-objdump, llvm-nm, llvm-lipo) with apt-get when root.
 
-ZIGBUILD_VERSION := 0.24.1
 LINUX_TARGET := x86_64-unknown-linux-gnu.2.17
 LINUX_SO := target/x86_64-unknown-linux-gnu/release/libgear_rattle.so
 DARWIN_ARCHS := x86_64 aarch64
@@ -31,7 +30,7 @@ TEST_TARGETS += test-portable
 # minimum macOS (zig's default is its newest).
 ZIGBUILD = mkdir -p target && cd target && \
 	CARGO_ZIGBUILD_PYTHON_PATH=$(CURDIR)/$(PY) MACOSX_DEPLOYMENT_TARGET=11.0 \
-	cargo-zigbuild rustc --manifest-path $(CURDIR)/Cargo.toml --release --lib --crate-type cdylib
+	$(CURDIR)/$(VENV)/bin/cargo-zigbuild rustc --manifest-path $(CURDIR)/Cargo.toml --release --lib --crate-type cdylib
 
 # cargo decides what to rebuild; these rules always ask it.
 $(LINUX_SO): FORCE | libclang zig-toolchain
@@ -76,9 +75,6 @@ zig-toolchain: $(VENV)/.installed
 			echo "Rust target $$a-apple-darwin missing: rustup target add $$a-apple-darwin"; \
 			rustup target add $$a-apple-darwin; }; \
 	done
-	@cargo-zigbuild --version 2>/dev/null | grep -qx 'cargo-zigbuild $(ZIGBUILD_VERSION)' || { \
-		echo "cargo-zigbuild $(ZIGBUILD_VERSION) missing: cargo install --locked cargo-zigbuild@$(ZIGBUILD_VERSION)"; \
-		cargo install --locked -j 2 cargo-zigbuild@$(ZIGBUILD_VERSION); }
 
 # Debian's llvm puts llvm-strip, llvm-objdump and llvm-nm on the PATH, llvm-lipo only in its
 # versioned directory. Evaluated when a recipe runs, after llvm-tools.
