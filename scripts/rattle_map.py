@@ -25,7 +25,7 @@ A level the FMU refuses is reported with the FMU's message and ends that bisecti
 
 --trajectory-stats adds what only the trajectory shows (free flights and their decay, impact
 speeds along a run, the shortest gap between two impacts on one flank): every grid point is also
-sampled every 50 us through fmpy, as before the study runner, and its impact counts checked
+sampled every 50 us through fmpy (gearrattle.study.sampled), and its impact counts checked
 against the stat_* outputs'.
 
 Outputs (in --out, default target/rattle_map): rattle_map.csv, threshold.csv, summary.txt,
@@ -103,9 +103,9 @@ def grid_rows(table, duration, t_from):
 
 def add_trajectory_stats(rows, fmu, workers, duration, t_from, fixed):
     """What needs the trajectory itself (free flights, impact speeds along a run, the shortest
-    gap between impacts on one flank), from every grid point sampled every 50 us through fmpy,
-    as rattle_map did before the study runner; and whether those samples count the impacts the
-    stat_* outputs count."""
+    gap between impacts on one flank), from every grid point sampled every 50 us through fmpy
+    (gearrattle.study.sampled); and whether those samples count the impacts the stat_* outputs
+    count."""
     from fmpy import extract
 
     ok = [r for r in rows if r["status"] == "ok"]
@@ -668,8 +668,8 @@ def main(argv=None):
                          "the default is the paper's parameters")
     ap.add_argument("--no-threshold", action="store_true", help="skip the threshold search")
     ap.add_argument("--trajectory-stats", action="store_true",
-                    help="also sample every grid point every 50 us through fmpy (as before the "
-                         "study runner: about 30 s more on 2 cores) for the statistics that need "
+                    help="also sample every grid point every 50 us through fmpy (the sampled "
+                         "engine: about 30 s more on 2 cores) for the statistics that need "
                          "the trajectory: free flights, impact speeds along a run, the shortest "
                          "gap between two impacts on one flank")
     ap.add_argument("--threshold-duration", type=float, default=1.0)

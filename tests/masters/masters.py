@@ -1,4 +1,4 @@
-"""Moved to python/gearrattle/masters.py; this alias keeps the tests'
+"""The code lives in python/gearrattle/masters.py; this alias keeps the tests'
 `import masters` working."""
 import sys
 from gearrattle import masters

@@ -1,4 +1,4 @@
-"""Moved to python/gearrattle/monolithic.py; this alias keeps the tests'
+"""The code lives in python/gearrattle/monolithic.py; this alias keeps the tests'
 `import monolithic` working."""
 import sys
 from gearrattle import monolithic

@@ -1,4 +1,4 @@
-"""Moved to python/gearrattle/reference.py; this alias keeps the tests'
+"""The code lives in python/gearrattle/reference.py; this alias keeps the tests'
 `import reference` working."""
 import sys
 from gearrattle import reference

@@ -1,4 +1,4 @@
-"""The stress cases of issue 4, as data, and how each one is run and judged.
+"""The stress cases, as data, and how each one is run and judged.
 
 Shared by tests/python/test_stress.py (pytest: one test per case) and
 scripts/stability_report.py (docs/STABILITY.md: one row per case), so that the report says
@@ -57,7 +57,7 @@ HERE = pathlib.Path(__file__).resolve().parent
 ROOT = HERE.parents[1]
 FMU_PATH = ROOT / "target" / "fmu" / "GearRattle.fmu"
 
-FACTOR = 10.0  # the error may be up to FACTOR × the requested tolerance (issue 4)
+FACTOR = 10.0  # the error may be up to FACTOR × the requested tolerance
 HOUR = 3600.0
 
 

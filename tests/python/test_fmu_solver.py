@@ -1,4 +1,4 @@
-"""The `solver` parameter and the `solver_method` output (issue 4): each method against the
+"""The `solver` parameter and the `solver_method` output: each method against the
 independent reference (tests/python/reference.py), and the automatic hand-over to Radau IIA
 on a stiff gear pair, which must give the explicit method's answer for far fewer right-hand
 sides (counted by the FMU: deterministic, not a timing)."""
@@ -48,7 +48,7 @@ def test_auto_hands_over_on_a_tiny_idler(fmu_run):
 
 
 def test_sine_cost_does_not_depend_on_the_communication_step(fmu_run):
-    """Issue 3: in sine mode communication points are served from the dense output of natural
+    """In sine mode communication points are served from the dense output of natural
     steps, so 10 µs communication steps cost the right-hand sides of 10 ms ones (counted by the
     FMU), and their values agree with the reference at every point."""
     t_end = 0.05

@@ -1,4 +1,4 @@
-"""Stress suite of issue 4: one test per case of stress_cases.CASES, run on the built FMU.
+"""The stress suite: one test per case of stress_cases.CASES, run on the built FMU.
 
 Each test runs its case through fmpy (stress_cases.Driver) and judges it
 (stress_cases.evaluate): no NaN/Inf in any output; the error against the independent
