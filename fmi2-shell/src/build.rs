@@ -10,6 +10,7 @@
 //! The GUID is a hash of the contract file, so the XML and the binary always carry the same
 //! one and any change of the contract changes it.
 
+use crate::contract::{Bound, Range};
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -64,8 +65,13 @@ struct Variable {
     start: Option<toml::Value>,
     unit: Option<String>,
     display_unit: Option<String>,
+    /// Inclusive bounds, written to the XML as min and max.
     min: Option<toml::Value>,
     max: Option<toml::Value>,
+    /// Exclusive bounds (I_L > 0: `min_exclusive = 0.0`), Real variables only: the XML
+    /// carries the nearest double inside the range as min or max.
+    min_exclusive: Option<f64>,
+    max_exclusive: Option<f64>,
     depends_on: Option<Vec<String>>,
     /// The FMU gives this output's first time derivative (fmi2GetRealOutputDerivatives).
     #[serde(default)]
@@ -75,7 +81,43 @@ struct Variable {
     derivative_of: Option<String>,
 }
 
+/// A TOML number as f64 (integers are exact up to 2^53).
+fn number(v: &toml::Value) -> f64 {
+    v.as_float()
+        .or(v.as_integer().map(|i| i as f64))
+        .expect("a number")
+}
+
 impl Variable {
+    /// The range the contract gives, inclusive and exclusive bounds together.
+    fn range(&self) -> Range {
+        let bound = |inclusive: &Option<toml::Value>, exclusive: Option<f64>| match (
+            inclusive, exclusive,
+        ) {
+            (Some(b), None) => Bound::Inclusive(number(b)),
+            (None, Some(b)) => Bound::Exclusive(b),
+            (None, None) => Bound::None,
+            (Some(_), Some(_)) => panic!(
+                "{}: an inclusive and an exclusive bound on one side",
+                self.name
+            ),
+        };
+        Range {
+            min: bound(&self.min, self.min_exclusive),
+            max: bound(&self.max, self.max_exclusive),
+        }
+    }
+
+    /// The description in the model description: the contract's, with the range stated.
+    fn full_description(&self) -> String {
+        let statement = self.range().statement(&self.name);
+        if statement.is_empty() {
+            self.description.clone()
+        } else {
+            format!("{} (range: {statement})", self.description)
+        }
+    }
+
     fn variability(&self) -> &'static str {
         match (self.causality.as_str(), self.ty.as_str()) {
             ("parameter", _) => "fixed",
@@ -130,6 +172,20 @@ fn check(c: &Contract) {
                 c.unit.iter().any(|d| &d.name == u),
                 "{}: unit {u} is not defined",
                 v.name
+            );
+        }
+        assert!(
+            v.ty == "Real" || (v.min_exclusive.is_none() && v.max_exclusive.is_none()),
+            "{}: exclusive bounds are for Real variables (an Integer's is min or max)",
+            v.name
+        );
+        let range = v.range();
+        if let Some(x) = v.start.as_ref().map(number) {
+            assert!(
+                range.contains(x),
+                "{}: start {x} outside its range {}",
+                v.name,
+                range.statement(&v.name)
             );
         }
         assert!(
@@ -216,6 +272,15 @@ fn value(v: &toml::Value) -> String {
     }
 }
 
+/// An XML min or max: the inclusive bound as written, or the double next to an exclusive
+/// one on the side of the range (x >= next_up(0) admits exactly the doubles x > 0).
+fn xml_bound(inclusive: &Option<toml::Value>, inside: Option<f64>) -> Option<String> {
+    inclusive
+        .as_ref()
+        .map(value)
+        .or(inside.map(|x| format!("{x:?}")))
+}
+
 fn xml(c: &Contract, guid: &str) -> String {
     let mut x = String::new();
     let m = &c.model;
@@ -281,7 +346,7 @@ fn xml(c: &Contract, guid: &str) -> String {
             "    <ScalarVariable name=\"{}\" valueReference=\"{}\" description=\"{}\" causality=\"{}\" variability=\"{}\"",
             esc(&v.name),
             v.vr,
-            esc(&v.description),
+            esc(&v.full_description()),
             v.causality,
             v.variability()
         )
@@ -294,8 +359,11 @@ fn xml(c: &Contract, guid: &str) -> String {
             ("start", v.start.as_ref().map(value)),
             ("unit", v.unit.as_deref().map(esc)),
             ("displayUnit", v.display_unit.as_deref().map(esc)),
-            ("min", v.min.as_ref().map(value)),
-            ("max", v.max.as_ref().map(value)),
+            ("min", xml_bound(&v.min, v.min_exclusive.map(f64::next_up))),
+            (
+                "max",
+                xml_bound(&v.max, v.max_exclusive.map(f64::next_down)),
+            ),
             (
                 "derivative",
                 v.derivative_of.as_deref().map(|s| index_of(s).to_string()),
@@ -366,6 +434,21 @@ fn xml(c: &Contract, guid: &str) -> String {
     x
 }
 
+/// A range as a Rust expression (paths in full: the including module imports only the
+/// contract's older types).
+fn rust_range(range: &Range) -> String {
+    let bound = |b: &Bound| match b {
+        Bound::None => "fmi2_shell::contract::Bound::None".to_string(),
+        Bound::Inclusive(x) => format!("fmi2_shell::contract::Bound::Inclusive({x:?})"),
+        Bound::Exclusive(x) => format!("fmi2_shell::contract::Bound::Exclusive({x:?})"),
+    };
+    format!(
+        "fmi2_shell::contract::Range {{ min: {}, max: {} }}",
+        bound(&range.min),
+        bound(&range.max)
+    )
+}
+
 fn rust(c: &Contract, guid: &str) -> String {
     let mut r =
         String::from("// Generated by fmi2-shell from the model's contract: do not edit.\n");
@@ -412,11 +495,12 @@ fn rust(c: &Contract, guid: &str) -> String {
         };
         writeln!(
             r,
-            "    Variable {{ name: {:?}, vr: {}, kind: Kind::{}, causality: Causality::{causality}, start: {start}, unit: {:?}, depends_on: &{:?}, derivative: {}, description: {:?} }},",
+            "    Variable {{ name: {:?}, vr: {}, kind: Kind::{}, causality: Causality::{causality}, start: {start}, unit: {:?}, range: {}, depends_on: &{:?}, derivative: {}, description: {:?} }},",
             v.name,
             v.vr,
             v.ty,
             v.unit.as_deref().unwrap_or(""),
+            rust_range(&v.range()),
             v.depends_on.as_deref().unwrap_or_default(),
             v.derivative,
             v.description
@@ -452,7 +536,7 @@ fn rust(c: &Contract, guid: &str) -> String {
     for (i, v) in c.variable.iter().enumerate() {
         writeln!(r, "        (Kind::{}, {}) => Some({i}),", v.ty, v.vr).unwrap();
     }
-    r += "        _ => None,\n    }\n}\n\n/// Looks a variable up by kind and value reference.\npub fn find(kind: Kind, vr: u32) -> Option<&'static Variable> {\n    index(kind, vr).map(|i| &VARIABLES[i])\n}\n\n/// The variable of a kind and value reference, or the importer's error for an unknown one.\npub fn variable(kind: Kind, vr: u32) -> fmi2_shell::FmiResult<&'static Variable> {\n    find(kind, vr).ok_or_else(|| fmi2_shell::contract::unknown(kind, vr))\n}\n";
+    r += "        _ => None,\n    }\n}\n\n/// Looks a variable up by kind and value reference.\npub fn find(kind: Kind, vr: u32) -> Option<&'static Variable> {\n    index(kind, vr).map(|i| &VARIABLES[i])\n}\n\n/// The variable of a kind and value reference, or the importer's error for an unknown one.\npub fn variable(kind: Kind, vr: u32) -> fmi2_shell::FmiResult<&'static Variable> {\n    find(kind, vr).ok_or_else(|| fmi2_shell::contract::unknown(kind, vr))\n}\n\n/// Checks every parameter against the range the contract gives it.\npub fn check_parameters(values: &fmi2_shell::values::Values) -> fmi2_shell::FmiResult {\n    fmi2_shell::contract::check_parameters(VARIABLES, values)\n}\n";
     r
 }
 

@@ -305,14 +305,21 @@ def _check_name(name, where, model, varied):
 
 
 def _check_bounds(name, lo, hi, where, model, what):
+    """Refuse values of name from lo to hi that leave the FMU's range (exclusive bounds
+    included: I_L = 0 against I_L > 0), naming the range and the fix."""
     v = model.parameters[name]
     unit = f" {v.unit}" if v.unit else ""
-    if v.min is not None and lo < v.min:
-        raise StudyError(f"{where}: {what} {name} = {lo:g}{unit} is below the FMU's minimum "
-                         f"{v.min:g}: keep {name} within {v.min:g}..{v.max if v.max is not None else 'inf'}")
-    if v.max is not None and hi > v.max:
-        raise StudyError(f"{where}: {what} {name} = {hi:g}{unit} is above the FMU's maximum "
-                         f"{v.max:g}: keep {name} within {v.min if v.min is not None else '-inf'}..{v.max:g}")
+    fix = f"keep {name} within its range {v.statement()}"
+    if math.isnan(lo) or math.isnan(hi):
+        raise StudyError(f"{where}: {what} {name} is not a number: {fix}")
+    if v.below(lo):
+        side = ("not above the FMU's exclusive minimum" if v.min_exclusive
+                else "below the FMU's minimum")
+        raise StudyError(f"{where}: {what} {name} = {lo:g}{unit} is {side} {v.min:g}: {fix}")
+    if v.above(hi):
+        side = ("not below the FMU's exclusive maximum" if v.max_exclusive
+                else "above the FMU's maximum")
+        raise StudyError(f"{where}: {what} {name} = {hi:g}{unit} is {side} {v.max:g}: {fix}")
 
 
 def validate(st, model):
