@@ -819,6 +819,16 @@ mod tests {
         dir
     }
 
+    /// Fails with the command's output unless it succeeded.
+    fn succeeded(what: &str, run: &std::process::Output) {
+        assert!(
+            run.status.success(),
+            "{what}:\n{}\n{}",
+            String::from_utf8_lossy(&run.stdout),
+            String::from_utf8_lossy(&run.stderr)
+        );
+    }
+
     /// The element of the model description naming `name`, up to its type's attributes.
     fn scalar<'a>(xml: &'a str, name: &str) -> &'a str {
         let start = xml
@@ -911,12 +921,9 @@ mod tests {
             .env("CARGO_TARGET_DIR", target)
             .output()
             .unwrap();
-        assert!(
-            run.status.success(),
-            "{}\n{}",
-            String::from_utf8_lossy(&run.stdout),
-            String::from_utf8_lossy(&run.stderr)
-        );
+        succeeded("the crate of GearboxRattle's constants", &run);
+        let out = String::from_utf8_lossy(&run.stdout);
+        assert!(out.contains("1 passed"), "its test did not run: {out}");
         fs::remove_dir_all(dir).unwrap();
     }
 
@@ -978,12 +985,7 @@ mod tests {
                 .arg(&dir)
                 .output()
                 .unwrap_or_else(|e| panic!("{python}: {e} (set FMPY_PYTHON or run make setup)"));
-            assert!(
-                run.status.success(),
-                "{name}: {}{}",
-                String::from_utf8_lossy(&run.stdout),
-                String::from_utf8_lossy(&run.stderr)
-            );
+            succeeded(name, &run);
             fs::remove_dir_all(dir).unwrap();
         }
     }
