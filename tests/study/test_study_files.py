@@ -129,3 +129,22 @@ def test_values_at_inclusive_bounds_and_just_inside_exclusive_ones_pass(fmu):
     st.axes = [spec.parse_axis("f_exc=30:60:2", "--x"), spec.parse_axis("A_rms=100:700:2", "--y")]
     st.fixed = {"alpha": (1.0, "--set"), "C": (0.0, "--set"), "I_L": (5e-324, "--set")}
     spec.validate(st, read_model(fmu))
+
+
+@pytest.mark.parametrize("name, description, xml, want", [
+    ("T_oil", "Oil temperature (range: T_oil > -95)", (-94.99999999999999, None),
+     (-95.0, True, None, False)),
+    ("n_gears", "Number of loose gears (range: 1 <= n_gears <= 8)", (1.0, 8.0),
+     (1.0, False, 8.0, False)),
+    ("gear[3].I_L", "Moment of inertia (range: gear[3].I_L > 0)", (5e-324, None),
+     (0.0, True, None, False)),
+    ("x", "An upper bound only (range: x < 1e-6)", (None, 9.999999999999999e-07),
+     (None, False, 1e-6, True)),
+    # No statement, or one about another name: the XML's min and max, inclusive.
+    ("C", "Viscous drag", (0.0, None), (0.0, False, None, False)),
+    ("C", "Viscous drag (range: G > 0)", (0.0, None), (0.0, False, None, False)),
+])
+def test_ranges_are_read_from_the_description_statement(name, description, xml, want):
+    from gearrattle.study.model import _range
+
+    assert _range(name, description, *xml) == want
