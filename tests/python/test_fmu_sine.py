@@ -8,7 +8,7 @@ import tomllib
 import numpy as np
 import pytest
 
-import reference as R
+from gearrattle import reference as R
 from conftest import CONTRACT_PATH
 
 P = R.params()

@@ -9,7 +9,7 @@ import pytest
 from fmpy import simulate_fmu
 from fmpy.fmi2 import FMU2Model, fmi2Error, fmi2EventInfo, fmi2OK
 
-import reference as R
+from gearrattle import reference as R
 
 G = R.DEFAULTS["G"]
 
