@@ -19,7 +19,6 @@ import math
 import pathlib
 import re
 import statistics
-import subprocess
 import time
 
 import matplotlib
