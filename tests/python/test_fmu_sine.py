@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from gearrattle import reference as R
-from conftest import CONTRACT_PATH
+from support.fmu import CONTRACT_PATH
 
 P = R.params()
 G = P["G"]

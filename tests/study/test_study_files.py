@@ -7,7 +7,6 @@ import pytest
 
 from gearrattle.study import cli, spec
 from gearrattle.study.errors import StudyError
-from study_support import fmu  # noqa: F401 (fixture)
 
 GOOD = """\
 kind = "mc"
