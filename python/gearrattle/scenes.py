@@ -18,8 +18,6 @@ OUTPUTS = [
 ]
 
 
-
-
 def _scene(name, **facts):
     """A scene of reference.SCENES (f [Hz], A_rms [rad/s^2 RMS]) with what is known of it."""
     return dict(name=name, f=R.SCENES[name]["f_exc"], A_rms=R.SCENES[name]["A_rms"], **facts)

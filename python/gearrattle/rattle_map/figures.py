@@ -29,7 +29,6 @@ def grid_array(rows, fs, As, key, scale=1.0):
     return Z
 
 
-
 def edges(v):
     v = np.asarray(v, dtype=float)
     if len(v) == 1:  # a single row or column: a cell 10 % wide
@@ -37,7 +36,6 @@ def edges(v):
         return np.array([v[0] - w / 2, v[0] + w / 2])
     d = np.diff(v)
     return np.concatenate(([v[0] - d[0] / 2], v[:-1] + d / 2, [v[-1] + d[-1] / 2]))
-
 
 
 def heatmap(ax, fs, As, Z, title, clabel, fmt, cmap="viridis", norm=None, fontsize=6.5):
@@ -80,11 +78,9 @@ def heatmap(ax, fs, As, Z, title, clabel, fmt, cmap="viridis", norm=None, fontsi
     return m
 
 
-
 def runs_norm():
     b = np.arange(0.5, 7.5, 1.0)
     return BoundaryNorm(b, plt.get_cmap("viridis").N, extend="max")
-
 
 
 MAPS = [
@@ -101,10 +97,8 @@ MAPS = [
 ]
 
 
-
 POWER_CONTACT = ("power_contact", None, "of which dissipated in the contact damping (impacts)",
                  "mW (log scale)", "{:.1f}", 1e3, LogNorm)
-
 
 
 def disp_contours(ax, fs, As, r_M):
@@ -115,7 +109,6 @@ def disp_contours(ax, fs, As, r_M):
     cs = ax.contour(F, AA, D, levels=[50, 100, 150, 200, 300, 400, 600], colors="w",
                     linewidths=0.9, linestyles="--", alpha=0.9)
     ax.clabel(cs, fmt="%g µm", fontsize=7, inline_spacing=2)
-
 
 
 def map_figures(rows, fs, As, out, meta, p):
@@ -152,7 +145,6 @@ def map_figures(rows, fs, As, out, meta, p):
     plt.close(fig)
     paths.append(path)
     return paths
-
 
 
 def threshold_figure(thr, out, meta, grid_range, p):
@@ -198,7 +190,6 @@ def threshold_figure(thr, out, meta, grid_range, p):
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return path
-
 
 
 def collapse_figure(rows, p, out):

@@ -11,11 +11,11 @@ import numpy as np
 
 from ..study import sampled
 
+# The FMU's outputs the map reads (an FMU without them is refused before anything runs).
 NEEDED = ["stat_impacts_Fplus", "stat_impacts_Fminus", "stat_runs_Fplus", "stat_runs_Fminus",
           "stat_run_mean_Fplus", "stat_run_mean_Fminus", "stat_run_max_Fplus",
           "stat_run_max_Fminus", "stat_v_mean_Fplus", "stat_v_mean_Fminus", "stat_v_max_Fplus",
           "stat_v_max_Fminus", "stat_P_contact", "stat_P_lubricant", "stat_a_rms"]
-
 
 CSV_COLS = [
     "f_Hz", "A_rms", "status", "periods", "impacts_Fplus", "impacts_Fminus",
@@ -33,7 +33,6 @@ TRAJECTORY = CSV_COLS[CSV_COLS.index("runs_decreasing"):CSV_COLS.index("sampled_
 
 def _weighted(a, wa, b, wb):
     return (a * wa + b * wb) / (wa + wb) if wa + wb else float("nan")
-
 
 
 def grid_rows(table, duration, t_from):
@@ -66,7 +65,6 @@ def grid_rows(table, duration, t_from):
     return rows
 
 
-
 def add_trajectory_stats(rows, fmu, workers, duration, t_from, fixed):
     """What needs the trajectory itself (free flights, impact speeds along a run, the shortest
     gap between impacts on one flank), from every grid point sampled every 50 us through fmpy
@@ -88,12 +86,10 @@ def add_trajectory_stats(rows, fmu, workers, duration, t_from, fixed):
                                         and st["impacts_Fminus"] == r["impacts_Fminus"])
 
 
-
 def fmt_cell(v):
     if isinstance(v, float):
         return "" if math.isnan(v) else f"{v:.6g}"
     return str(v)
-
 
 
 def write_grid_csv(rows, path):
@@ -103,7 +99,6 @@ def write_grid_csv(rows, path):
         for r in sorted(rows, key=lambda r: (r["f_Hz"], r["A_rms"])):
             w.writerow([fmt_cell(r.get(c, "")) for c in CSV_COLS])
     return path
-
 
 
 def write_threshold_csv(thr, path):
@@ -124,13 +119,11 @@ def write_threshold_csv(thr, path):
     return path
 
 
-
 def param_note(p, meta):
     """'paper's parameters (G = 25 µm)', or the overridden parameters."""
     if not meta["set"]:
         return f"paper's parameters (G = {1e6 * p['G']:g} µm)"
     return "paper's parameters except " + ", ".join(f"{k} = {v:g}" for k, v in meta["set"].items())
-
 
 
 def power_fit(fs, a):
@@ -142,13 +135,11 @@ def power_fit(fs, a):
     return np.exp(c) * 30 ** pw, pw
 
 
-
 def spearman(x, y):
     from scipy.stats import spearmanr
 
     ok = np.isfinite(x) & np.isfinite(y)
     return float(spearmanr(x[ok], y[ok]).statistic) if np.count_nonzero(ok) > 2 else float("nan")
-
 
 
 def collapse_data(rows, p):

@@ -37,7 +37,6 @@ def trajectory_lines(ok, p, meta):
          for s in SCENES for r in ok if r["f_Hz"] == s["f"] and r["A_rms"] == s["A_rms"]]
 
 
-
 def summary_lines(rows, thr, fs, As, p, meta):
     L = []
     ok = [r for r in rows if r["status"] == "ok"]

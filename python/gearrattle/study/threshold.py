@@ -35,7 +35,6 @@ def classify(r):
     return ("transient" if lp + lm == 0 else "sustained"), lp, lm
 
 
-
 def _run_levels(study, model, data, session, points, out):
     """Classes of the levels {(f, A)} run as one study in out."""
     study.out = out
@@ -43,7 +42,6 @@ def _run_levels(study, model, data, session, points, out):
                                                          for f, A in points], session=session)
     res = {(r["f_exc"], r["A_rms"]): r for r in table.to_pylist()}
     return {k: (classify(res[k]), res[k]["message"]) for k in points}
-
 
 
 def scan_one(f, levels, classes, meta):
@@ -60,7 +58,6 @@ def scan_one(f, levels, classes, meta):
         elif c is not None:
             streak = None
     return scan, streak
-
 
 
 def thresholds(study, model, data, session, fs, meta, base):
