@@ -12,7 +12,7 @@ $(VENV)/.installed: python/pyproject.toml
 
 ## bench-study: the study runner against the sampled engine and the FMU stepped from C -> docs/STUDY_BENCH.md
 bench-study: fmu $(VENV)/.installed
-	$(PY) -m gearrattle.study.bench --fmu $(FMU) --out $(STUDY_BENCH_OUT) --report docs/STUDY_BENCH.md
+	$(PY) benches/study/study_bench.py --fmu $(FMU) --out $(STUDY_BENCH_OUT) --report docs/STUDY_BENCH.md
 
 # The benchmark's reference solutions depend on the reference (python/gearrattle/reference.py).
 $(BENCH_REF): python/gearrattle/reference.py

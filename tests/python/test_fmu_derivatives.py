@@ -2,7 +2,7 @@
 against finite differences and against the same motion given as plain inputs."""
 
 import numpy as np
-import reference as R
+from gearrattle import reference as R
 
 
 def shaft(t):

@@ -27,7 +27,7 @@ from fmpy.fmi2 import (
     fmi2Integer,
 )
 
-import reference as R
+from gearrattle import reference as R
 
 REFUSED = (fmi2Discard, fmi2Error)  # a refused call: not OK, not Warning, never Fatal
 UNKNOWN_VR = 999

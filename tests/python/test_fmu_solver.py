@@ -1,12 +1,12 @@
 """The `solver` parameter and the `solver_method` output: each method against the
-independent reference (tests/python/reference.py), and the automatic hand-over to Radau IIA
+independent reference (gearrattle/reference.py), and the automatic hand-over to Radau IIA
 on a stiff gear pair, which must give the explicit method's answer for far fewer right-hand
 sides (counted by the FMU: deterministic, not a timing)."""
 
 import numpy as np
 import pytest
 
-import reference as R
+from gearrattle import reference as R
 
 AUTO, EXPLICIT, IMPLICIT = 0, 1, 2
 DOPRI5, RADAU = 1, 2

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from fmpy.fmi2 import FMU2Slave, fmi2OK
 
-import reference as R
+from gearrattle import reference as R
 from test_fmu_misuse import REFUSED, Slave
 
 P = R.params()

@@ -8,8 +8,7 @@ import subprocess
 import time
 
 from gearrattle.study.engine import batches
-from study_support import (STUDY, assert_same_rows, cluster, fmu, rows,  # noqa: F401
-                           study)
+from support.study import STUDY, assert_same_rows, rows, study
 
 # A small map in sine mode: 4 x 3 points of 0.3 s (statistics from 0.15 s, half the duration).
 SMALL = ["map", "--x", "f_exc=30:60:4", "--y", "A_rms=100:500:3", "--duration", "0.3",

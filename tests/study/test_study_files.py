@@ -6,7 +6,7 @@ import os
 import pytest
 
 from gearrattle.study import cli, spec
-from study_support import fmu  # noqa: F401 (fixture)
+from gearrattle.study.errors import StudyError
 
 GOOD = """\
 kind = "mc"
@@ -104,7 +104,7 @@ def test_stats_from_on_an_fmu_without_it_is_refused(fmu):
                                                    if k != "stats_from"})
     st = spec.Study(kind="map", fmu=fmu, out="unused", stats_from=(0.3, "--stats-from 0.3"))
     st.axes = [spec.parse_axis("f_exc=30:60:2", "--x"), spec.parse_axis("A_rms=100:700:2", "--y")]
-    with pytest.raises(spec.StudyError, match=r"--stats-from 0.3: this FMU has no parameter "
+    with pytest.raises(StudyError, match=r"--stats-from 0.3: this FMU has no parameter "
                                               r"stats_from.*make fmu"):
         spec.validate(st, older)
 

@@ -13,7 +13,7 @@ import sys
 import time
 
 from . import spec
-from .spec import StudyError
+from .errors import StudyError
 
 DEFAULT_FMU = os.path.join("target", "fmu", "GearRattle.fmu")
 

@@ -6,6 +6,8 @@ import os
 
 import numpy as np
 
+from . import figures, montecarlo
+from .table import column, ok_rows
 
 # The metrics drawn in the overview figures (all of them are in points.csv): where a user of a
 # rattle map looks first. An FMU without them gets its first metrics drawn.
@@ -19,18 +21,8 @@ def figure_metrics(metrics, record):
     return (drawn or [m for m in metrics if m not in record][:len(FIGURE_METRICS)]) + list(record)
 
 
-def ok_rows(table):
-    return np.asarray(table.column("status").to_pylist()) == "ok"
-
-
-def column(table, name):
-    return np.asarray(table.column(name).to_numpy(zero_copy_only=False), dtype=float)
-
-
 def write(st, model, table, wall):
     """Summary lines and the list of files written."""
-    from . import figures, montecarlo
-
     n = table.num_rows
     ok = ok_rows(table)
     cpu = column(table, "cpu_s")

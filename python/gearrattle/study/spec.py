@@ -12,6 +12,7 @@ import tomllib
 from dataclasses import dataclass, field
 
 from .distributions import Dist, parse_dist
+from .errors import StudyError
 from .model import METRIC_PREFIX, STATS_FROM
 
 KINDS = ("map", "doe", "mc")
@@ -22,10 +23,6 @@ DEFAULT_STATS_FROM = 0.2
 # The studies run the FMU alone, with no master feeding its inputs: the paper's sine bench
 # (excitation = 1) unless the study sets another mode.
 STANDALONE = {"excitation": 1}
-
-
-class StudyError(Exception):
-    """A study refused before anything runs; the message names the place and the fix."""
 
 
 @dataclass
