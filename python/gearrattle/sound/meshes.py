@@ -1,0 +1,189 @@
+"""The mesh forces of an FMU, sampled finely through fmpy (docs/SOUND.md, "The force").
+
+The meshes come from the model description, so that an FMU plugs in by naming its outputs:
+GearRattle has one mesh, `F_contact`; the gearbox has `gear[i].F_contact` for i = 1..n_gears
+(FMI 2.0 structured names, n_gears a parameter). A mesh's impacts are read from its cumulative
+counters `<prefix>impacts_Fplus` and `<prefix>impacts_Fminus` when the FMU has them, else from
+the force's onsets (F leaving zero).
+
+The FMU is stepped on the grid t_n = n h, h = 1 / (48 kHz · SUBSAMPLE): every SUBSAMPLE-th
+sample is a sample of the WAV, so the pressure at the WAV's instants needs no resampling."""
+
+from dataclasses import dataclass, field
+import re
+import time
+
+import numpy as np
+
+from .metrics import FS
+
+SUBSAMPLE = 4  # force samples per WAV sample: h = 5.2 µs (docs/SOUND.md, "Error")
+FORCE = "F_contact"
+COUNTERS = ("impacts_Fplus", "impacts_Fminus")
+# Start values that make a lone FMU run the paper's bench (the FMU's defaults are scene S1).
+STANDALONE = {"excitation": 1}
+
+
+@dataclass
+class Mesh:
+    name: str  # "gear[2]" or "" (GearRattle's single mesh)
+    force: object  # fmpy ScalarVariable of the force
+    counters: tuple  # the two counters' variables, or ()
+
+    @property
+    def label(self):
+        return self.name or "mesh"
+
+
+@dataclass
+class Run:
+    """What one FMU run gives the sound: the force samples of each mesh on the grid
+    t = t0 + n h, and each mesh's impact instants as intervals (t_lo, t_hi] with their flank
+    (1 = F+, 2 = F-, 0 = from the force's onset)."""
+    h: float
+    t0: float
+    forces: list  # one array per mesh
+    impacts: list  # per mesh: array of (t_lo, t_hi, flank)
+    meshes: list
+    values: dict  # the start values set
+    cpu_s: float = 0.0
+    steps: int = 0
+    extra: dict = field(default_factory=dict)
+
+
+def meshes(md, values):
+    """The meshes of a model description, with the start values `values` (for n_gears)."""
+    by_name = {v.name: v for v in md.modelVariables}
+
+    def counters(prefix):
+        vs = tuple(by_name.get(prefix + c) for c in COUNTERS)
+        return vs if all(v is not None and v.causality == "output" for v in vs) else ()
+
+    if "n_gears" in by_name:
+        n = int(values.get("n_gears", float(by_name["n_gears"].start)))
+        out = []
+        for i in range(1, n + 1):
+            v = by_name.get(f"gear[{i}].{FORCE}")
+            if v is None:
+                raise ValueError(f"n_gears = {n} but the FMU has no output gear[{i}].{FORCE}: "
+                                 f"set n_gears to at most the number of gear[i] outputs")
+            out.append(Mesh(f"gear[{i}]", v, counters(f"gear[{i}].")))
+        return out
+    if FORCE in by_name:
+        return [Mesh("", by_name[FORCE], counters(""))]
+    gears = sorted({m[1] for m in (re.match(r"(gear\[\d+\])\.", n) for n in by_name) if m})
+    raise ValueError(f"the FMU has no output {FORCE} nor a parameter n_gears"
+                     + (f" (it has {', '.join(gears)})" if gears else "")
+                     + ": the sound needs each mesh's contact force")
+
+
+def start_values(md, sets):
+    """The start values of a run: STANDALONE where the FMU has it, then the user's sets, each
+    checked against the model description. Raises ValueError naming the fix."""
+    import difflib
+
+    params = {v.name: v for v in md.modelVariables if v.causality == "parameter"}
+    values = {k: v for k, v in STANDALONE.items() if k in params}
+    for name, value in sets.items():
+        if name not in params:
+            near = difflib.get_close_matches(name, list(params), 3)
+            raise ValueError(f"--set {name}: not a parameter of this FMU"
+                             + (f": did you mean {' or '.join(near)}?" if near else ""))
+        values[name] = value
+    return values
+
+
+def simulate(fmu, md, values, duration, t_record=0.0, subsample=SUBSAMPLE):
+    """Run the FMU (a .fmu or an extracted directory) from 0 to duration with these start
+    values and record each mesh's force from t_record on. Returns a Run."""
+    from fmpy import extract, instantiate_fmu
+
+    ms = meshes(md, values)
+    unzip = fmu if not str(fmu).endswith(".fmu") else extract(fmu)
+    inst = instantiate_fmu(unzip, md, fmi_type="CoSimulation")
+    t_cpu = time.process_time()
+    try:
+        inst.setupExperiment(startTime=0.0, stopTime=duration)
+        _set(inst, md, values)
+        inst.enterInitializationMode()
+        inst.exitInitializationMode()
+        if t_record > 0:
+            inst.doStep(0.0, t_record)
+        run = record(inst, ms, t_record, duration, subsample)
+    finally:
+        inst.terminate()
+        inst.freeInstance()
+    run.values = values
+    run.cpu_s = time.process_time() - t_cpu
+    return run
+
+
+def record(inst, ms, t0, t_end, subsample=SUBSAMPLE):
+    """Step an initialised instance from t0 to t_end on the grid t0 + n h and read the forces
+    and counters at every point; the raw FMI calls with arrays made once keep fmpy's own cost
+    to a few µs a step."""
+    import ctypes
+
+    h = 1.0 / (FS * subsample)
+    n = int(round((t_end - t0) / h))
+    vr_f = (ctypes.c_uint * len(ms))(*[m.force.valueReference for m in ms])
+    counted = [m for m in ms if m.counters]
+    vr_c = (ctypes.c_uint * (2 * len(counted)))(
+        *[c.valueReference for m in counted for c in m.counters])
+    f_buf = (ctypes.c_double * len(ms))()
+    c_buf = (ctypes.c_int * len(vr_c))()
+    F = np.zeros((n + 1, len(ms)))
+    C = np.zeros((n + 1, len(vr_c)), dtype=np.int64)
+
+    def read(k):
+        inst.fmi2GetReal(inst.component, vr_f, len(ms), f_buf)
+        F[k] = f_buf
+        if counted:
+            inst.fmi2GetInteger(inst.component, vr_c, len(vr_c), c_buf)
+            C[k] = c_buf
+
+    read(0)
+    t = t0
+    for k in range(1, n + 1):
+        t_next = t0 + k * h
+        status = inst.fmi2DoStep(inst.component, t, t_next - t, 1)
+        if status != 0:
+            raise RuntimeError(f"fmi2DoStep at t = {t:.9g} s returned status {status}")
+        t = t_next
+        read(k)
+    impacts = []
+    col = 0
+    for j, m in enumerate(ms):
+        if m.counters:
+            impacts.append(_from_counters(C[:, col], C[:, col + 1], t0, h))
+            col += 2
+        else:
+            impacts.append(_from_force(F[:, j], t0, h))
+    return Run(h=h, t0=t0, forces=[F[:, j] for j in range(len(ms))], impacts=impacts,
+               meshes=ms, values={}, steps=n)
+
+
+def _from_counters(n_plus, n_minus, t0, h):
+    rows = []
+    for flank, c in ((1, n_plus), (2, n_minus)):
+        for k in np.nonzero(np.diff(c) > 0)[0]:
+            rows += [(t0 + k * h, t0 + (k + 1) * h, flank)] * int(c[k + 1] - c[k])
+    rows.sort()
+    return np.array(rows, dtype=float).reshape(-1, 3)
+
+
+def _from_force(F, t0, h):
+    k = np.nonzero((F[:-1] == 0) & (F[1:] != 0))[0]
+    return np.column_stack([t0 + k * h, t0 + (k + 1) * h, np.zeros(len(k))])
+
+
+def _set(inst, md, values):
+    by_name = {v.name: v for v in md.modelVariables}
+    for name, value in values.items():
+        v = by_name[name]
+        if v.type == "Real":
+            inst.setReal([v.valueReference], [float(value)])
+        elif v.type == "Boolean":
+            inst.setBoolean([v.valueReference], [bool(value)])
+        else:
+            inst.setInteger([v.valueReference], [int(value)])
