@@ -79,7 +79,7 @@ def listen(a):
     from fmpy import read_model_description
 
     from . import figures
-    from .meshes import SUBSAMPLE, simulate
+    from .meshes import SUBSAMPLE, meshes, simulate
     from .metrics import FS, full_scale, metrics, read_wav, write_wav
     from .render import load_transfer, render
 
@@ -90,6 +90,8 @@ def listen(a):
     md = read_model_description(a.fmu)
     transfer = load_transfer(a.transfer)
     todo = scenes(a, md)
+    for _, values in todo:
+        transfer.check_meshes(len(meshes(md, values)))
     os.makedirs(a.out, exist_ok=True)
     done = []
     for label, values in todo:
@@ -123,8 +125,25 @@ def listen(a):
     path = os.path.join(a.out, "sound.txt")
     with open(path, "w") as fh:
         fh.write("\n".join(lines) + "\n")
-    files.append(path)
+    files += [path, _json(os.path.join(a.out, "sound.json"), transfer, heard, scale)]
     return lines, files
+
+
+def _json(path, transfer, heard, scale):
+    """sound.json: sound.txt's figures for scripts."""
+    import json
+
+    scenes = [{"label": label, "values": run.values, "N5": m.N5, "N_mean": m.N_mean,
+               "sharpness": m.sharpness, "LAeq": m.LAeq,
+               "impacts": [len(i) for i in run.impacts],
+               "meshes": [mesh.force.name for mesh in run.meshes],
+               "shares": [float(s) for s in snd.shares()],
+               "cpu_s": {"simulation": run.cpu_s, "filtering": snd.cpu_s, "metrics": m.cpu_s}}
+              for label, run, snd, m in heard]
+    with open(path, "w") as fh:
+        json.dump({"transfer": transfer.describe(), "full_scale_Pa": scale, "scenes": scenes},
+                  fh, indent=1, allow_nan=True)
+    return path
 
 
 def _values_text(values):

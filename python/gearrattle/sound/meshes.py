@@ -9,7 +9,7 @@ the force's onsets (F leaving zero).
 The FMU is stepped on the grid t_n = n h, h = 1 / (48 kHz · SUBSAMPLE): every SUBSAMPLE-th
 sample is a sample of the WAV, so the pressure at the WAV's instants needs no resampling."""
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 import re
 import time
 
@@ -48,7 +48,6 @@ class Run:
     values: dict  # the start values set
     cpu_s: float = 0.0
     steps: int = 0
-    extra: dict = field(default_factory=dict)
 
 
 def meshes(md, values):

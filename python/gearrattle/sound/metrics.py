@@ -17,6 +17,7 @@ and the reported figures cannot disagree.
 from dataclasses import dataclass
 
 import numpy as np
+from mosqito.sq_metrics import loudness_zwtv, sharpness_din_from_loudness
 
 FS = 48000  # the WAVs' sample rate [Hz]
 CALIBRATION = "sound pressure: 1.0 = {:.17g} Pa"  # the WAV comment
@@ -87,8 +88,6 @@ def laeq(p, fs):
 def metrics(p, fs=FS):
     """The metrics of p [Pa] sampled at fs."""
     import time
-
-    from mosqito.sq_metrics import loudness_zwtv, sharpness_din_from_loudness
 
     t0 = time.process_time()
     p = np.asarray(p, dtype=float)

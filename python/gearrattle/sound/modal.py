@@ -18,6 +18,7 @@ every sample, so the only error is the force's deviation from its linear interpo
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.signal import cont2discrete, lfilter, ss2tf
 
 
 @dataclass(frozen=True)
@@ -53,8 +54,6 @@ DEFAULT_MODES = (
 def foh_coefficients(mode, h):
     """(b, a) of the FOH recursion of a mode with unit gain at the sample interval h [s]:
     p[n] = b0 F[n] + b1 F[n−1] + b2 F[n−2] − a1 p[n−1] − a2 p[n−2]."""
-    from scipy.signal import cont2discrete, ss2tf
-
     w = 2 * np.pi * mode.f
     A = np.array([[0.0, 1.0], [-w * w, -2 * mode.zeta * w]])
     B = np.array([[0.0], [1.0]])
@@ -82,8 +81,6 @@ class ModalTransfer:
 
     def pressure(self, force, mesh, h):
         """The pressure [Pa] of one mesh's force samples F[n] = F(n h), zero state before."""
-        from scipy.signal import lfilter
-
         force = np.asarray(force, dtype=float)
         p = np.zeros_like(force)
         for m in self.modes:
