@@ -441,6 +441,28 @@ def overview_figure(path, scene, res, st, p, t_from, n_periods):
     plt.close(fig)
 
 
+# --------------------------------------------------------------------------- sound
+
+def s1_sound(fmu, out, duration):
+    """The sound of S1 through the default housing (gearrattle-study listen, docs/SOUND.md):
+    out/S1_sound/ and out/S1_rattle.wav; prints its loudness and sharpness."""
+    import json
+    import shutil
+
+    from gearrattle.study.cli import main as study
+
+    where = os.path.join(out, "S1_sound")
+    if study(["listen", "--fmu", fmu, "--duration", str(duration), "--out", where, "--quiet"]):
+        raise RuntimeError("gearrattle-study listen failed")
+    wav = shutil.copy(os.path.join(where, "rattle.wav"), os.path.join(out, "S1_rattle.wav"))
+    with open(os.path.join(where, "sound.json")) as fh:
+        s = json.load(fh)["scenes"][0]
+    print(f"\nS1 heard through the default housing ({wav}, docs/SOUND.md): loudness N5 "
+          f"{s['N5']:.2f} sone (mean {s['N_mean']:.2f}), sharpness {s['sharpness']:.2f} acum, "
+          f"LAeq {s['LAeq']:.1f} dB(A)")
+    return os.path.join(where, "spectrogram.png")
+
+
 # --------------------------------------------------------------------------- main
 
 def main(argv=None):
@@ -498,6 +520,8 @@ def main(argv=None):
 
     if results:
         print_summary(results, t_from)
+    if any(s["name"] == "S1" for s, *_ in results):
+        figures.append(s1_sound(args.fmu, args.out, args.duration))
     print()
     print(f"total demo time {time.perf_counter() - t_all:.1f} s "
           f"(simulate_fmu {sum(r[2] for r in results):.1f} s)")

@@ -118,55 +118,56 @@ def simulate(fmu, md, values, duration, t_record=0.0, subsample=SUBSAMPLE):
 
 
 def record(inst, ms, t0, t_end, subsample=SUBSAMPLE):
-    """Step an initialised instance from t0 to t_end on the grid t0 + n h and read the forces
-    and counters at every point; the raw FMI calls with arrays made once keep fmpy's own cost
-    to a few µs a step."""
+    """Step an initialised instance from t0 to t_end on the grid t0 + n h, reading the forces
+    at every point (straight into the result's memory) and the impact counters at the WAV's
+    samples; an impact is then placed at its force's onset within that sample interval. The
+    raw FMI calls with arrays made once keep Python's cost to a few µs a step."""
     import ctypes
 
     h = 1.0 / (FS * subsample)
     n = int(round((t_end - t0) / h))
-    vr_f = (ctypes.c_uint * len(ms))(*[m.force.valueReference for m in ms])
-    counted = [m for m in ms if m.counters]
+    m = len(ms)
+    vr_f = (ctypes.c_uint * m)(*[x.force.valueReference for x in ms])
+    counted = [j for j, x in enumerate(ms) if x.counters]
     vr_c = (ctypes.c_uint * (2 * len(counted)))(
-        *[c.valueReference for m in counted for c in m.counters])
-    f_buf = (ctypes.c_double * len(ms))()
+        *[c.valueReference for j in counted for c in ms[j].counters])
+    F = np.zeros((n + 1, m))
+    f_mem = ctypes.c_double.from_buffer(F)  # the first sample: byref(f_mem, offset) the others
     c_buf = (ctypes.c_int * len(vr_c))()
-    F = np.zeros((n + 1, len(ms)))
-    C = np.zeros((n + 1, len(vr_c)), dtype=np.int64)
-
-    def read(k):
-        inst.fmi2GetReal(inst.component, vr_f, len(ms), f_buf)
-        F[k] = f_buf
-        if counted:
-            inst.fmi2GetInteger(inst.component, vr_c, len(vr_c), c_buf)
-            C[k] = c_buf
-
-    read(0)
-    t = t0
-    for k in range(1, n + 1):
-        t_next = t0 + k * h
-        status = inst.fmi2DoStep(inst.component, t, t_next - t, 1)
-        if status != 0:
-            raise RuntimeError(f"fmi2DoStep at t = {t:.9g} s returned status {status}")
-        t = t_next
-        read(k)
-    impacts = []
-    col = 0
-    for j, m in enumerate(ms):
-        if m.counters:
-            impacts.append(_from_counters(C[:, col], C[:, col + 1], t0, h))
-            col += 2
-        else:
-            impacts.append(_from_force(F[:, j], t0, h))
-    return Run(h=h, t0=t0, forces=[F[:, j] for j in range(len(ms))], impacts=impacts,
+    at, C = [], []  # the grid indices where the counters are read, and their values
+    get_real, get_int, do_step, comp = (inst.fmi2GetReal, inst.fmi2GetInteger, inst.fmi2DoStep,
+                                        inst.component)
+    for k in range(n + 1):
+        if k:
+            status = do_step(comp, t0 + (k - 1) * h, h, 1)
+            if status != 0:
+                raise RuntimeError(f"fmi2DoStep at t = {t0 + (k - 1) * h:.9g} s returned "
+                                   f"status {status}")
+        get_real(comp, vr_f, m, ctypes.byref(f_mem, 8 * m * k))
+        if counted and (k % subsample == 0 or k == n):
+            get_int(comp, vr_c, len(vr_c), c_buf)
+            at.append(k)
+            C.append(list(c_buf))
+    impacts = [_from_force(F[:, j], t0, h) for j in range(m)]
+    C = np.array(C, dtype=np.int64).reshape(len(at), len(vr_c))
+    for col, j in enumerate(counted):
+        impacts[j] = _from_counters(np.array(at), C[:, 2 * col], C[:, 2 * col + 1], F[:, j],
+                                    t0, h)
+    return Run(h=h, t0=t0, forces=[F[:, j].copy() for j in range(m)], impacts=impacts,
                meshes=ms, values={}, steps=n)
 
 
-def _from_counters(n_plus, n_minus, t0, h):
+def _from_counters(at, n_plus, n_minus, F, t0, h):
+    """The impacts the counters read at the grid indices `at` show, each placed at the force's
+    first onset in its reading interval (the whole interval when the force shows none)."""
+    onsets = np.nonzero((F[:-1] == 0) & (F[1:] != 0))[0] + 1
     rows = []
     for flank, c in ((1, n_plus), (2, n_minus)):
-        for k in np.nonzero(np.diff(c) > 0)[0]:
-            rows += [(t0 + k * h, t0 + (k + 1) * h, flank)] * int(c[k + 1] - c[k])
+        for i in np.nonzero(np.diff(c) > 0)[0]:
+            lo, hi = at[i], at[i + 1]
+            inside = onsets[(onsets > lo) & (onsets <= hi)]
+            k_lo, k_hi = (inside[0] - 1, inside[0]) if len(inside) else (lo, hi)
+            rows += [(t0 + k_lo * h, t0 + k_hi * h, flank)] * int(c[i + 1] - c[i])
     rows.sort()
     return np.array(rows, dtype=float).reshape(-1, 3)
 
