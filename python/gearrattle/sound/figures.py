@@ -24,7 +24,8 @@ def spectrogram(path, sound, run, title):
 
     plt = _plt()
     fig, (ax, aw) = plt.subplots(2, 1, figsize=(10, 6.5), height_ratios=(2.2, 1))
-    f, t, S = stft(sound.mix, FS, nperseg=512, noverlap=384, scaling="spectrum")
+    seg = min(512, len(sound.mix))  # 10.7 ms windows, 3/4 overlapping
+    f, t, S = stft(sound.mix, FS, nperseg=seg, noverlap=3 * seg // 4, scaling="spectrum")
     S_db = 10 * np.log10(np.maximum(S, 1e-30) / P_REF ** 2)
     top = float(S_db.max()) if np.isfinite(S_db).any() else 0.0
     mesh = ax.pcolormesh(sound.t0 + t, f / 1e3, S_db, shading="auto", cmap="magma",
