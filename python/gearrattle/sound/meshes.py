@@ -95,23 +95,30 @@ def start_values(md, sets):
 def simulate(fmu, md, values, duration, t_record=0.0, subsample=SUBSAMPLE):
     """Run the FMU (a .fmu or an extracted directory) from 0 to duration with these start
     values and record each mesh's force from t_record on. Returns a Run."""
+    import shutil
+
     from fmpy import extract, instantiate_fmu
 
     ms = meshes(md, values)
-    unzip = fmu if not str(fmu).endswith(".fmu") else extract(fmu)
-    inst = instantiate_fmu(unzip, md, fmi_type="CoSimulation")
-    t_cpu = time.process_time()
+    packed = str(fmu).endswith(".fmu")
+    unzip = extract(fmu) if packed else fmu
     try:
-        inst.setupExperiment(startTime=0.0, stopTime=duration)
-        _set(inst, md, values)
-        inst.enterInitializationMode()
-        inst.exitInitializationMode()
-        if t_record > 0:
-            inst.doStep(0.0, t_record)
-        run = record(inst, ms, t_record, duration, subsample)
+        inst = instantiate_fmu(unzip, md, fmi_type="CoSimulation")
+        t_cpu = time.process_time()
+        try:
+            inst.setupExperiment(startTime=0.0, stopTime=duration)
+            _set(inst, md, values)
+            inst.enterInitializationMode()
+            inst.exitInitializationMode()
+            if t_record > 0:
+                inst.doStep(0.0, t_record)
+            run = record(inst, ms, t_record, duration, subsample)
+        finally:
+            inst.terminate()
+            inst.freeInstance()
     finally:
-        inst.terminate()
-        inst.freeInstance()
+        if packed:
+            shutil.rmtree(unzip, ignore_errors=True)
     run.values = values
     run.cpu_s = time.process_time() - t_cpu
     return run
