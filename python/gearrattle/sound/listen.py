@@ -61,6 +61,8 @@ def scenes(a, md):
 
 
 def main(a):
+    from fmpy.fmi1 import FMICallException
+
     from ..study.spec import StudyError
 
     try:
@@ -68,6 +70,10 @@ def main(a):
     except (ValueError, StudyError) as e:
         print(f"gearrattle-study listen: error: {e}", file=sys.stderr)
         return 2
+    except (FMICallException, RuntimeError) as e:
+        print(f"gearrattle-study listen: the FMU refused the run ({e}): check the --set values "
+              f"against its model description", file=sys.stderr)
+        return 1
     if not a.quiet:
         print("\n".join(lines))
         print("files:\n" + "\n".join(f"  {f}" for f in files))

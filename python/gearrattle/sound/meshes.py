@@ -113,8 +113,8 @@ def simulate(fmu, md, values, duration, t_record=0.0, subsample=SUBSAMPLE):
             if t_record > 0:
                 inst.doStep(0.0, t_record)
             run = record(inst, ms, t_record, duration, subsample)
-        finally:
             inst.terminate()
+        finally:
             inst.freeInstance()
     finally:
         if packed:
