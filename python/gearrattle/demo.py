@@ -142,6 +142,26 @@ def print_summary(results, t_from):
         print("  - " + v)
 
 
+def s1_sound(fmu, out, duration):
+    """The sound of S1 through the default housing (gearrattle-study listen, docs/SOUND.md):
+    out/S1_sound/ and out/S1_rattle.wav; prints its loudness and sharpness."""
+    import json
+    import shutil
+
+    from .study.cli import main as study
+
+    where = os.path.join(out, "S1_sound")
+    if study(["listen", "--fmu", fmu, "--duration", str(duration), "--out", where, "--quiet"]):
+        raise RuntimeError("gearrattle-study listen failed")
+    wav = shutil.copy(os.path.join(where, "rattle.wav"), os.path.join(out, "S1_rattle.wav"))
+    with open(os.path.join(where, "sound.json")) as fh:
+        s = json.load(fh)["scenes"][0]
+    print(f"\nS1 heard through the default housing ({wav}, docs/SOUND.md): loudness N5 "
+          f"{s['N5']:.2f} sone (mean {s['N_mean']:.2f}), sharpness {s['sharpness']:.2f} acum, "
+          f"LAeq {s['LAeq']:.1f} dB(A)")
+    return os.path.join(where, "spectrogram.png")
+
+
 def run(fmu=FMU, out=OUT, duration=1.0, interval=1e-5, scenes="S1,S2,S3"):
     """Run the scenes named in `scenes` (comma-separated) for `duration` s each with outputs
     every `interval` s, print their statistics and the comparison with the paper, write the
@@ -188,6 +208,8 @@ def run(fmu=FMU, out=OUT, duration=1.0, interval=1e-5, scenes="S1,S2,S3"):
 
     if results:
         print_summary(results, t_from)
+    if any(s["name"] == "S1" for s, *_ in results):
+        figures.append(s1_sound(fmu, out, duration))
     print()
     print(f"total demo time {time.perf_counter() - t_all:.1f} s "
           f"(simulate_fmu {sum(r[2] for r in results):.1f} s)")

@@ -84,6 +84,7 @@ class Study:
     exceed: list = field(default_factory=list)  # mc: [Exceed]
     sensitivity: str = "none"
     record: list = field(default_factory=list)  # outputs recorded besides the stat_* ones
+    sound: bool = False  # the sound columns of each point (gearrattle.sound.study)
     source: str = "command line"
 
     def varied(self):
