@@ -10,6 +10,7 @@ import math
 import numpy as np
 import pytest
 from scipy.integrate import quad
+from scipy.optimize import brentq
 
 from gearrattle import gearbox_reference as B
 
@@ -100,6 +101,24 @@ def test_damper_two_stage_period():
     assert r.stage_t[1] == pytest.approx(t2, rel=1e-10)
     assert r.stage_t[5] - r.stage_t[1] == pytest.approx(period, rel=1e-10)
     assert r.stage_t[2] - r.stage_t[1] == pytest.approx(2 * t1, rel=1e-10)
+
+
+def test_damper_friction_per_stage():
+    """Flywheel held, no viscous loss: the first swing from phi_0 = 0.1 rad to -phi_a loses
+    to the hysteresis H_2 beyond phi_1 and H_1 within it (§2, tanh ~ sign away from the
+    turning points): V_cl(phi_0) - V_cl(phi_a) = H_2 (phi_0 + phi_a - 2 phi_1) + 2 H_1 phi_1."""
+    p = B.params(phi_start=0.1, c_cl=0.0, c_I=0.0, **HELD, **FLYING)
+    H1, H2, phi1 = p["H_1"], p["H_2"], p["phi_1"]
+
+    def V(phi):
+        return float(B.damper_spring(phi, p)[1])
+
+    phi_a = brentq(lambda x: V(0.1) - V(x) - H2 * (0.1 + x - 2 * phi1) - 2 * H1 * phi1, phi1, 0.1)
+    t = np.linspace(0.0, 0.025, 12501)
+    r = B.simulate(p, 0.025, t_eval=t)
+    assert r.stage[:4].tolist() == [1, 0, -1, 0] and r.stage_t[2] < t[np.argmin(r.phi)] < r.stage_t[3]
+    assert -r.phi.min() == pytest.approx(phi_a, abs=2e-8)
+    assert 0.1 - phi_a > 1e5 * 2e-8  # the loss is resolved
 
 
 def test_energy_balance_lossless():
