@@ -48,6 +48,8 @@ def test_engine_speed_against_closed_form():
     theta_F = om * t - sum(a / (n * om) ** 2 * (np.cos(n * om * t + ph) - math.cos(ph)) for n, a, ph in terms)
     assert np.max(np.abs(r.omega_F - omega_F(t))) < 1e-11 * om
     assert np.max(np.abs(r.theta_F - theta_F)) < 1e-11 * om * 0.3
+    # GEARBOX.md §6's start: the input side at omega_F(0), the gear at rigid meshing speed
+    assert r.omega_I[0] == pytest.approx(omega_F(0.0), rel=1e-15) and r.xi_dot[0, 0] == 0.0
     # alpha_F (the recorded motion's) is the closed form's derivative
     h = 1e-6
     assert np.max(np.abs(B.engine_acceleration(t, p) - (omega_F(t + h) - omega_F(t - h)) / (2 * h))) < 1e-3
@@ -66,6 +68,7 @@ def test_engine_ramp_against_quadrature():
         return ramp + 600.0 * math.cos(2.0 * angle + 0.3) + 120.0 * math.cos(4.0 * angle)
 
     assert r.omega_F[0] == pytest.approx(om + 600.0 / (2.0 * om) * math.sin(0.3), rel=1e-15)
+    assert np.allclose(B.engine_acceleration(t, p), [alpha_F(s) for s in t], rtol=0.0, atol=1e-9)
     for tk, wk in zip(t, r.omega_F):
         ref = r.omega_F[0] + quad(alpha_F, 0.0, tk, limit=500, epsabs=1e-13)[0]
         assert wk == pytest.approx(ref, rel=1e-11)
