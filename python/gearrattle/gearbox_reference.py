@@ -47,6 +47,7 @@ F+) or upwards through G (flank F-).
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field
 
@@ -107,6 +108,13 @@ DEFAULTS = dict(
 for _i, _row in enumerate(_TABLE, start=1):
     DEFAULTS.update(_gear_defaults(_i, _row))
 
+# Scenes: B1, B2 of GEARBOX.md §8 and R1, a run-down from 800 to 500 rpm over 2 s.
+SCENES = {
+    "B1": dict(),
+    "B2": dict(T_oil=-10.0),
+    "R1": dict(rpm_rate=-150.0),
+}
+
 # Damper stage codes: -1 main stage (phi < -phi_1), 0 pre-damper, +1 main stage (phi > phi_1).
 IDLE = 0
 
@@ -116,10 +124,12 @@ _XTOL = 1e-16
 _TWO_PI = 2.0 * math.pi
 
 
-def params(**overrides) -> dict:
-    """Full parameter dict: DEFAULTS, then overrides (contract names, "gear[i].X" for gears;
-    gears beyond the defaults' five need all their keys)."""
+def params(scene: str | None = None, **overrides) -> dict:
+    """Full parameter dict: DEFAULTS, then the scene's (SCENES), then overrides (contract
+    names, "gear[i].X" for gears; gears beyond the defaults' five need all their keys)."""
     p = dict(DEFAULTS)
+    if scene is not None:
+        p.update(SCENES[scene])
     allowed = set(DEFAULTS) | {f"gear[{i}].{k}" for i in range(1, MAX_GEARS + 1) for k in GEAR_KEYS}
     unknown = set(overrides) - allowed
     if unknown:
@@ -560,6 +570,15 @@ def _root(dense, ix, edge, a, b):
     if fa == 0.0:
         return a
     return brentq(lambda s: dense(s)[ix] - edge, a, b, xtol=_XTOL, rtol=_BRENT_RTOL)
+
+
+@functools.lru_cache(maxsize=None)
+def scene(name: str, t_end: float, dt_out: float, method: str = "DOP853", rtol: float = 1e-12) -> Result:
+    """A scene of SCENES with the defaults, outputs every dt_out (i * dt_out), cached for
+    the tests of one session."""
+    t_eval = np.arange(int(round(t_end / dt_out)) + 1) * dt_out
+    t_eval[-1] = min(t_eval[-1], t_end)
+    return simulate(params(name), t_end, t_eval=t_eval, method=method, rtol=rtol)
 
 
 # ----------------------------------------------------------------------------------------
