@@ -6,9 +6,11 @@ the GearboxRattle FMU against. Parameters are keyed by the FMU's contract names
 
 Coordinates are relative (GEARBOX.md §3): the state is
 
-    y = [phi, omega_I, w_F, q_F, xi_1..xi_N, xi_dot_1..xi_dot_N, quadratures]
+    y = [phi, phi_dot, w_F, q_F, xi_1..xi_N, xi_dot_1..xi_dot_N, quadratures]
 
-* phi = theta_F - theta_I, the damper's twist; omega_I the input side's speed;
+* phi = theta_F - theta_I, the damper's twist, and phi_dot = omega_F - omega_I its rate:
+  the input side's speed omega_I = omega_F - phi_dot is never a state, whose tolerance
+  (relative to ~100 rad/s) would blur xi_dot by r_M times its error;
 * the flywheel (§4) as omega_F = Omega_0 + Omega' t + w_F and
   theta_F = Omega_0 t + Omega' t^2/2 + q_F: w_F' = sum_k a_k cos(psi_k) and q_F' = w_F are
   integrated with the rest (quadrature, ramp or not: no Fresnel integrals), so that the
@@ -26,7 +28,7 @@ Then, with T_cl, F_i, c_I(T) and C_i(T) of §2, §5 and MODEL.md §2:
     omega_I'  = (T_cl + sum_i rho_i r_M,i F_i - c_I omega_I) / I_I
     xi_i''    = r_L,i (B_i - r_L,i F_i - C_i (omega_L,i - omega_S,i)) / I_L,i
                 - r_M,i rho_i omega_I'
-    phi'      = omega_F - omega_I
+    phi_dot'  = alpha_F - omega_I'
 
 and the energy of §3, E = 1/2 I_I omega_I^2 + sum 1/2 I_L,i omega_L,i^2 + V_cl(phi) +
 sum V_i(xi_i), obeys E(t) - E(0) = W_F - D_damper - D_input - sum (D_contact_i +
@@ -39,7 +41,9 @@ any of them crosses. The steps are driven by hand with scipy's DOP853 (or Radau,
 independent second method); after each step every gear's xi and the twist phi are checked
 at the step's end and, where their rate changed sign inside the step, at the turning point
 found on the dense output, so that an edge crossed and recrossed within one step (a grazing
-touch) is not skipped. The crossing is located by a root search on the dense output.
+touch) is not skipped. The crossing is located by a root search on the dense output, and
+the state there is reached by a step of the method from the step's start (the dense
+output's error, carried on at every restart, would limit the accuracy).
 
 Impacts are contact onsets (MODEL.md §1): a gear leaving the gap downwards through 0 (flank
 F+) or upwards through G (flank F-).
@@ -271,13 +275,13 @@ def _make_rhs(p: dict, gears: list, stage: int, codes: tuple):
     tanh, cos = math.tanh, math.cos
 
     def rhs(t, y):
-        phi, om_I, w_F = y[0], y[1], y[2]
+        phi, phi_dot, w_F = y[0], y[1], y[2]
         angle = om0 * t + 0.5 * ramp * t * t
         a_F = 0.0
         for n_k, a_k, ph_k in orders:
             a_F += a_k * cos(n_k * angle + ph_k)
         om_F = om0 + ramp * t + w_F
-        phi_dot = om_F - om_I
+        om_I = om_F - phi_dot
         if stage == IDLE:
             T_k = k1 * phi
         elif stage > 0:
@@ -300,7 +304,7 @@ def _make_rhs(p: dict, gears: list, stage: int, codes: tuple):
             d_lub[i] = C * slip * slip
             w_ext[i] = B * om_L - C * slip * om_S
         a_I = (T_cl + reaction - c_I * om_I) / I_I
-        dy = [phi_dot, a_I, a_F, w_F]
+        dy = [phi_dot, ramp + a_F - a_I, a_F, w_F]
         dy += y[4 + n : 4 + 2 * n].tolist()
         dy += [acc[i] - rows[i][2] * a_I for i in range(n)]
         dy += [T_cl * om_F, T_f * phi_dot, c_I * om_I * om_I]
@@ -403,7 +407,7 @@ def simulate(
     e_scale: float = 1e-3,
 ) -> Result:
     """Integrate the gearbox from t = 0 to t_end (start of GEARBOX.md §6: theta_F(0) = 0,
-    phi(0) = phi_start, omega_I(0) = omega_F(0), each gear at rigid meshing speed with
+    phi(0) = phi_start, omega_I(0) = omega_F(0) (phi_dot(0) = 0), each gear at rigid meshing speed with
     xi_i(0) = gap_start_i G_i).
 
     p: full parameter dict (see `params`); t_eval: increasing output times in [0, t_end]
@@ -420,7 +424,6 @@ def simulate(
 
     y = np.zeros(lay.size)
     y[0] = p["phi_start"]
-    y[1] = om_F0
     y[2] = om_F0 - om0
     for i, g in enumerate(gears):
         y[lay.xi + i] = g["gap_start"] * g["G"]
@@ -435,7 +438,7 @@ def simulate(
     damper_regions = [(-1, -math.inf, -phi1), (IDLE, -phi1, phi1), (1, phi1, math.inf)]
 
     def twist_rate(t, yy):
-        return om0 + ramp * t + yy[2] - yy[1]
+        return yy[1]
 
     switches = [(0, twist_rate, damper_regions)]
     for i, g in enumerate(gears):
@@ -490,7 +493,8 @@ def simulate(
         t_c, j, side = crossing
         ix, _, reg = switches[j]
         _, lo, hi = reg[region[j]]
-        y = solver.dense_output()(t_c) if dense is None else dense(t_c)
+        y, fev = _reach(solver_cls, rhs, t_old, y_old, t_c, rtol, atol)
+        nfev += fev
         y[ix] = lo if side < 0 else hi
         stalls = stalls + 1 if t_c <= t else 0
         if stalls > 20:
@@ -523,7 +527,7 @@ def simulate(
         params=p,
         t=t_eval,
         phi=out[0],
-        omega_I=out[1],
+        omega_I=om0 + ramp * t_eval + out[2] - out[1],
         omega_F=om0 + ramp * t_eval + out[2],
         theta_F=om0 * t_eval + 0.5 * ramp * t_eval**2 + out[3],
         xi=out[lay.xi : lay.xi + n].reshape(n, n_t),
@@ -539,6 +543,19 @@ def simulate(
         rtol=rtol,
         final_y=np.array(y),
     )
+
+
+def _reach(solver_cls, rhs, t0, y0, t1, rtol, atol):
+    """(y(t1), RHS calls) by steps of the method itself from (t0, y0), normally one: its end
+    value is more accurate than the dense output, whose error a restart would carry on."""
+    if t1 <= t0:
+        return np.array(y0), 0
+    solver = solver_cls(rhs, t0, y0, t1, rtol=rtol, atol=atol, first_step=t1 - t0)
+    while solver.status == "running":
+        solver.step()
+    if solver.status == "failed":
+        raise RuntimeError(f"no step from {t0} to {t1}")
+    return np.array(solver.y), solver.nfev
 
 
 def _edge_in_step(solver, dense, ix, rate, lo, hi, t_old, y_old, t_new, y_new):
