@@ -407,13 +407,13 @@ def simulate(
     e_scale: float = 1e-3,
 ) -> Result:
     """Integrate the gearbox from t = 0 to t_end (start of GEARBOX.md §6: theta_F(0) = 0,
-    phi(0) = phi_start, omega_I(0) = omega_F(0) (phi_dot(0) = 0), each gear at rigid meshing speed with
-    xi_i(0) = gap_start_i G_i).
+    phi(0) = phi_start, omega_I(0) = omega_F(0) (phi_dot(0) = 0), each gear at rigid meshing
+    speed with xi_i(0) = gap_start_i G_i).
 
     p: full parameter dict (see `params`); t_eval: increasing output times in [0, t_end]
     (default: 0 and t_end); method: 'DOP853' or 'Radau'; rtol: relative tolerance, the
-    absolute ones being rtol times phi_1, 1 rad/s, 1 rad/s, 1 rad, G_i, 3600 G_i /s and
-    e_scale [J] for the quadratures."""
+    absolute ones being rtol times phi_1, 1 rad/s (phi_dot), 1 rad/s (w_F), 1 rad (q_F),
+    G_i, 3600 G_i /s and e_scale [J] for the quadratures."""
     p = params() if p is None else dict(p)
     if p["excitation"] != 1:
         raise ValueError("the reference has the built-in engine only (excitation = 1)")
@@ -433,16 +433,11 @@ def simulate(
         atol[lay.xi + i] = rtol * g["G"]
         atol[lay.xi_dot + i] = rtol * g["G"] * 3600.0
 
-    # switches: (index of x in y, rate function (t, y) -> x', ordered regions)
+    # switches: (index of x in y, index of its rate x', ordered regions)
     phi1 = p["phi_1"]
     damper_regions = [(-1, -math.inf, -phi1), (IDLE, -phi1, phi1), (1, phi1, math.inf)]
-
-    def twist_rate(t, yy):
-        return yy[1]
-
-    switches = [(0, twist_rate, damper_regions)]
-    for i, g in enumerate(gears):
-        switches.append((lay.xi + i, (lambda k: lambda _t, yy: yy[k])(lay.xi_dot + i), _regions(g)))
+    switches = [(0, 1, damper_regions)]
+    switches += [(lay.xi + i, lay.xi_dot + i, _regions(g)) for i, g in enumerate(gears)]
     region = [next(k for k, (_, lo, hi) in enumerate(reg) if lo <= y[ix] <= hi) for ix, _, reg in switches]
 
     t_eval = np.array([0.0, t_end]) if t_eval is None else np.asarray(t_eval, dtype=float)
@@ -473,9 +468,9 @@ def simulate(
             nsteps += 1
             t_new, y_new = solver.t, solver.y
             dense = None
-            for j, (ix, rate, reg) in enumerate(switches):
+            for j, (ix, iv, reg) in enumerate(switches):
                 _, lo, hi = reg[region[j]]
-                found, dense = _edge_in_step(solver, dense, ix, rate, lo, hi, t_old, y_old, t_new, y_new)
+                found, dense = _edge_in_step(solver, dense, ix, iv, lo, hi, t_old, y_old, y_new)
                 if found is not None and (crossing is None or found[0] < crossing[0]):
                     crossing = (found[0], j, found[1])
             t_lim = t_new if crossing is None else crossing[0]
@@ -558,16 +553,16 @@ def _reach(solver_cls, rhs, t0, y0, t1, rtol, atol):
     return np.array(solver.y), solver.nfev
 
 
-def _edge_in_step(solver, dense, ix, rate, lo, hi, t_old, y_old, t_new, y_new):
-    """The first crossing of lo or hi by y[ix] within the step [t_old, t_new], as
-    ((t_c, side), dense) with side -1 (lo) or +1 (hi), or (None, dense). A turning point of
-    y[ix] inside the step (its rate changes sign) is located and checked as well; `dense`
-    is the step's dense output, computed here only when needed and handed back."""
-    t_from = t_old
-    r_old, r_new = rate(t_old, y_old), rate(t_new, y_new)
-    if r_old * r_new < 0.0:
+def _edge_in_step(solver, dense, ix, iv, lo, hi, t_old, y_old, y_new):
+    """The first crossing of lo or hi by y[ix] within the solver's last step (from t_old,
+    y_old to solver.t, y_new), as ((t_c, side), dense) with side -1 (lo) or +1 (hi), or
+    (None, dense). A turning point of y[ix] inside the step (its rate y[iv] changes sign) is
+    located and checked as well; `dense` is the step's dense output, computed here only
+    when needed and handed back."""
+    t_from, t_new = t_old, solver.t
+    if y_old[iv] * y_new[iv] < 0.0:
         dense = dense or solver.dense_output()
-        t_turn = brentq(lambda s: rate(s, dense(s)), t_old, t_new, xtol=_XTOL, rtol=_BRENT_RTOL)
+        t_turn = brentq(lambda s: dense(s)[iv], t_old, t_new, xtol=_XTOL, rtol=_BRENT_RTOL)
         x_turn = dense(t_turn)[ix]
         if x_turn < lo:
             return (_root(dense, ix, lo, t_old, t_turn), -1), dense
