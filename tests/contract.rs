@@ -6,8 +6,8 @@
 
 use fmi2_shell::values::Values;
 use gear_rattle::contract::{Causality, Kind, STATES, VARIABLES, Variable, vr};
-use gear_rattle::instance::Simulation;
 use gear_rattle::instance::model_exchange::column;
+use gear_rattle::instance::{Carry, Simulation};
 use std::collections::BTreeSet;
 
 /// A simulation in contact on F+ and moving (so that the contact's stiffness and damping
@@ -27,7 +27,7 @@ fn starting_at(excitation: i64, gap_start: f64) -> Simulation {
     values.set_real(vr::alpha_M, 40.0);
     values.set_real(vr::tau_in, 0.5);
     values.set_real(vr::stats_from, 0.0);
-    Simulation::new(&values, 0.0, 0.0, 1e-6).expect("valid parameters")
+    Simulation::new(&values, 0.0, 0.0, 1e-6, Carry::Asked).expect("valid parameters")
 }
 
 fn outputs(kind: Kind) -> impl Iterator<Item = &'static Variable> {
