@@ -36,7 +36,7 @@ pub const N: usize = E_CONTACT + quadrature::COUNT;
 pub type State = [f64; N];
 
 /// The torque-driven pair with its `N`-component state (the gear pairs' common code,
-/// [`contact_pieces`], is written for any size).
+/// `contact_pieces!`, is written for any size).
 pub type TorqueRattle = DrivenRattle<N>;
 
 /// The gear pair, the region it is in, the main shaft's inertia and the torque driving it.
