@@ -47,7 +47,7 @@ bench-profile: | libclang
 ## bench-reference: the independent reference solutions of the benchmark scenes
 bench-reference: $(BENCH_REF)
 
-$(BENCH_REF): scripts/bench_reference.py tests/python/reference.py | $(VENV)/.installed
+$(BENCH_REF): scripts/bench_reference.py | $(VENV)/.installed
 	$(PY) scripts/bench_reference.py --out $(BENCH_DIR)/reference
 
 ## bench-overhead: the statistics' cost on S1 against the FMU library of OVERHEAD_BASE, from C (prints)
@@ -60,5 +60,5 @@ bench-overhead: $(LIB)
 	git -C $(OVERHEAD_TREE) checkout --quiet --detach $(OVERHEAD_BASE)
 	cd $(OVERHEAD_TREE) && cargo build --release --lib
 	@mkdir -p $(BENCH_DIR)
-	$(CC) -O2 -I python/gearrattle/study/c -o $(BENCH_DIR)/overhead benches/overhead/overhead.c -ldl
+	$(CC) -O2 -I benches/study -o $(BENCH_DIR)/overhead benches/overhead/overhead.c -ldl
 	$(PYTHON) scripts/bench_overhead.py --base $(OVERHEAD_TREE) --new . --harness $(BENCH_DIR)/overhead

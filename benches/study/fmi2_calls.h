@@ -1,6 +1,6 @@
-/* The FMI 2.0 co-simulation calls the C harnesses use (step_points.c, the overhead benchmark
- * benches/overhead/overhead.c): their types, a logger to stderr, a symbol looked up or the
- * process ended, the process's CPU time. */
+/* The FMI 2.0 co-simulation calls the C harnesses use (step_points.c beside this file, the
+ * overhead benchmark benches/overhead/overhead.c): their types, a logger to stderr, a symbol
+ * looked up or the process ended, the process's CPU time. */
 #ifndef FMI2_CALLS_H
 #define FMI2_CALLS_H
 #include <dlfcn.h>
