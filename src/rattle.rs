@@ -52,7 +52,8 @@ pub struct Impacts {
 
 /// The gear pair, the region it is in, and what drives the main shaft; its state has `N`
 /// components, the quadratures of [`window::quadrature`] up to `N` ([`Rattle`],
-/// [`LeanRattle`]).
+/// [`LeanRattle`]; with `N` = 2, ξ and ξ' alone, it measures what the energies cost:
+/// tests/extras_cost.rs).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct KinematicRattle<const N: usize> {
     pub dynamics: Dynamics,
@@ -450,16 +451,18 @@ impl<const N: usize> KinematicRattle<N> {
         let a: [f64; RATES] = std::array::from_fn(|k| {
             lever * (if k == 0 { p.B } else { 0.0 } - p.r_L * force[k] - p.C * slip[k])
         });
-        let contact = math::series_product(&xi_dot, &xi_dot);
-        let lubricant = math::series_product(&slip, &slip);
-        let shaft = math::series_product(&force, &omega_M);
         c[0][E_CONTACT..].copy_from_slice(&y[E_CONTACT..]);
-        for (k, row) in c.iter_mut().enumerate().skip(1) {
-            // The coefficient k − 1 of each rate, integrated: / k.
-            let inv_k = math::INVERSES[k];
-            row[E_CONTACT] = p.C_LM * contact[k - 1] * inv_k;
-            row[E_LUBRICANT] = p.C * lubricant[k - 1] * inv_k;
-            row[W_SHAFT] = -p.r_M * shaft[k - 1] * inv_k;
+        if N > E_CONTACT {
+            let contact = math::series_product(&xi_dot, &xi_dot);
+            let lubricant = math::series_product(&slip, &slip);
+            let shaft = math::series_product(&force, &omega_M);
+            for (k, row) in c.iter_mut().enumerate().skip(1) {
+                // The coefficient k − 1 of each rate, integrated: / k.
+                let inv_k = math::INVERSES[k];
+                row[E_CONTACT] = p.C_LM * contact[k - 1] * inv_k;
+                row[E_LUBRICANT] = p.C * lubricant[k - 1] * inv_k;
+                row[W_SHAFT] = -p.r_M * shaft[k - 1] * inv_k;
+            }
         }
         if N > E_CONTACT + quadrature::ENERGIES {
             let a2 = math::series_product(&a, &a);
@@ -508,7 +511,9 @@ impl<const N: usize> ClosedForm<N> for FreeFlight<'_, '_, N> {
         let mut y = *self.y0;
         y[XI] = f.xi;
         y[XI_DOT] = f.xi_dot;
-        y[E_LUBRICANT] += f.e_lubricant;
+        if N > E_LUBRICANT {
+            y[E_LUBRICANT] += f.e_lubricant;
+        }
         if N > E_CONTACT + quadrature::A2 {
             y[E_CONTACT + quadrature::A2] +=
                 flight_a2(&self.rattle.dynamics.params, t - self.t0, &f);
