@@ -33,7 +33,7 @@ use fmi::fmi2::import::Fmi2Import;
 use fmi::fmi2::instance::{CoSimulation, Common};
 use fmi2_shell::values::Values;
 use gear_rattle::contract::vr;
-use gear_rattle::instance::Simulation;
+use gear_rattle::instance::{Carry, Simulation};
 use gear_rattle::integrator::Solver;
 use gear_rattle::physics::{Dynamics, Excitation, GearParams, Sine};
 use gear_rattle::rattle::{N, Rattle, State, XI, XI_DOT};
@@ -382,7 +382,8 @@ fn run_steps(sc: &Scene, rtol: f64, comm: f64) -> Outcome {
     let n = (sc.t_end / comm).round() as usize;
     let (every, stride) = sampling(comm);
     let start = cpu_now();
-    let mut sim = Simulation::new(&fmu_values(sc), 0.0, 0.0, rtol).map_err(|e| e.message)?;
+    let mut sim =
+        Simulation::new(&fmu_values(sc), 0.0, 0.0, rtol, Carry::Asked).map_err(|e| e.message)?;
     let mut run = Run::with_capacity(n / every + 1);
     let record = |run: &mut Run, sim: &Simulation| {
         run.xi.push(sim.real_output(vr::xi).unwrap());

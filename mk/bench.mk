@@ -5,11 +5,12 @@
 #
 #   make bench            everything (reference only when missing or outdated)
 #   make bench-reference  the independent reference alone (scripts/bench_reference.py)
+#   make bench-overhead   what the rattle statistics cost a run, against an older FMU library
 
 BENCH_DIR := target/bench
 BENCH_REF := $(BENCH_DIR)/reference/scenes.csv
 
-.PHONY: bench bench-reference bench-profile
+.PHONY: bench bench-reference bench-profile bench-overhead
 
 ## bench: work-precision benchmark -> docs/BENCHMARKS.md, docs/work_precision.png
 bench: fmu $(VENV)/.installed $(BENCH_REF) | libclang
@@ -48,3 +49,16 @@ bench-reference: $(BENCH_REF)
 
 $(BENCH_REF): scripts/bench_reference.py | $(VENV)/.installed
 	$(PY) scripts/bench_reference.py --out $(BENCH_DIR)/reference
+
+## bench-overhead: the statistics' cost on S1 against the FMU library of OVERHEAD_BASE, from C (prints)
+# The base commit is checked out in a worktree under target/ and built there (its own target/,
+# about 8 min the first time); both libraries are stepped alternately by one C harness.
+OVERHEAD_BASE ?= dd70606
+OVERHEAD_TREE := target/overhead-base
+bench-overhead: $(LIB)
+	@test -d $(OVERHEAD_TREE) || git worktree add --detach $(OVERHEAD_TREE) $(OVERHEAD_BASE)
+	git -C $(OVERHEAD_TREE) checkout --quiet --detach $(OVERHEAD_BASE)
+	cd $(OVERHEAD_TREE) && cargo build --release --lib
+	@mkdir -p $(BENCH_DIR)
+	$(CC) -O2 -I benches/study -o $(BENCH_DIR)/overhead benches/overhead/overhead.c -ldl
+	$(PYTHON) scripts/bench_overhead.py --base $(OVERHEAD_TREE) --new . --harness $(BENCH_DIR)/overhead

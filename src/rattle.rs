@@ -3,7 +3,8 @@
 //! quadratures), the region as the current piece, and the impact counters (MODEL.md §1: an
 //! impact is ξ leaving the gap, across 0 downwards on F+ or G upwards on F−). [`torque`] is
 //! the same gear pair with the main shaft an inertia driven by a torque (torque mode);
-//! [`window`] the rattle statistics over a window of time.
+//! [`window`] the rattle statistics over a window of time. A pair carries the window's
+//! quadratures only when a window is asked for ([`Rattle`]; [`LeanRattle`] without them).
 #![allow(non_snake_case)]
 
 pub mod torque;
@@ -21,15 +22,24 @@ use crate::physics::{
 use window::{Quadratures, Window, quadrature};
 
 /// Components of the state vector: ξ, ξ', then the quadratures of [`window::quadrature`]
-/// (the dissipated energies, the shaft's work, ∫a² dt, ∫F dt, ∫F² dt).
+/// (the dissipated energies, the shaft's work, and with a statistics window ∫a² dt, ∫F dt,
+/// ∫F² dt).
 pub const XI: usize = 0;
 pub const XI_DOT: usize = 1;
 pub const E_CONTACT: usize = 2;
 pub const E_LUBRICANT: usize = E_CONTACT + quadrature::E_LUBRICANT;
 pub const W_SHAFT: usize = E_CONTACT + quadrature::W_SHAFT;
+/// Size of the state with the statistics window's quadratures.
 pub const N: usize = E_CONTACT + quadrature::COUNT;
+/// Size of the state without them: the energies and the work alone.
+pub const N_LEAN: usize = E_CONTACT + quadrature::ENERGIES;
 
 pub type State = [f64; N];
+
+/// The pair with every quadrature, as a run with a statistics window needs it.
+pub type Rattle = KinematicRattle<N>;
+/// The pair without the window's quadratures (a run that asks for no statistics).
+pub type LeanRattle = KinematicRattle<N_LEAN>;
 
 /// Impacts counted so far.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -40,9 +50,12 @@ pub struct Impacts {
     pub last_speed: f64,
 }
 
-/// The gear pair, the region it is in, and what drives the main shaft.
+/// The gear pair, the region it is in, and what drives the main shaft; its state has `N`
+/// components, the quadratures of [`window::quadrature`] up to `N` ([`Rattle`],
+/// [`LeanRattle`]; with `N` = 2, ξ and ξ' alone, it measures what the energies cost:
+/// tests/extras_cost.rs).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Rattle {
+pub struct KinematicRattle<const N: usize> {
     pub dynamics: Dynamics,
     pub region: Region,
     pub excitation: Excitation,
@@ -53,11 +66,11 @@ pub struct Rattle {
     flight_start: Option<FlightStart>,
 }
 
-impl Rattle {
+impl<const N: usize> KinematicRattle<N> {
     /// The pair at ξ, with no statistics window (one opens with [`GearPair::with_window`]).
     pub fn new(dynamics: Dynamics, excitation: Excitation, xi: f64) -> Self {
         let region = dynamics.law.classify(xi);
-        Rattle {
+        KinematicRattle {
             region,
             dynamics,
             excitation,
@@ -113,9 +126,9 @@ pub trait GearPair<const N: usize>: Piecewise<N> {
         let (xi, xi_dot) = (y[Self::GUARD], y[Self::RATE]);
         self.dynamics().loads(self.region(), xi, xi_dot, &shaft)
     }
-    /// The quadratures at y.
+    /// The quadratures at y; 0 for those the state does not carry.
     fn quadratures(y: &[f64; N]) -> Quadratures {
-        std::array::from_fn(|i| y[Self::E_CONTACT + i])
+        std::array::from_fn(|i| y.get(Self::E_CONTACT + i).copied().unwrap_or(0.0))
     }
 }
 
@@ -158,24 +171,24 @@ pub(crate) fn cross_edge(
     entered
 }
 
-impl System<N> for Rattle {
+impl<const N: usize> System<N> for KinematicRattle<N> {
     #[inline]
-    fn rhs(&self, t: f64, y: &State) -> State {
+    fn rhs(&self, t: f64, y: &[f64; N]) -> [f64; N] {
         self.rhs_in(self.region, t, y)
     }
 }
 
-impl Rattle {
+impl<const N: usize> KinematicRattle<N> {
     /// The right-hand side with the formula of `region` (the benchmark's peers keep the
     /// region apart, where their crates' closures can follow it).
     #[inline]
-    pub fn rhs_in(&self, region: Region, t: f64, y: &State) -> State {
+    pub fn rhs_in(&self, region: Region, t: f64, y: &[f64; N]) -> [f64; N] {
         let shaft = self.excitation.at(t);
         let loads = self.dynamics.loads(region, y[XI], y[XI_DOT], &shaft);
         let q = quadrature_rates(&self.dynamics.params, &loads, y[XI_DOT], shaft.omega);
         let mut f = [0.0; N];
         (f[XI], f[XI_DOT]) = (y[XI_DOT], loads.xi_ddot);
-        f[E_CONTACT..].copy_from_slice(&q);
+        f[E_CONTACT..].copy_from_slice(&q[..N - E_CONTACT]);
         f
     }
 }
@@ -207,8 +220,10 @@ pub(crate) fn quadrature_rates(
 /// end: a at the step's ends (the start's from the step before, when it ended at t0) and
 /// middle, and, where the parabola through them peaks inside the step above the window's
 /// peak so far, that peak located by successive parabolic interpolation on the dense output.
-/// Points outside the current piece (past an edge the step is redone to end on) are not the
-/// piece's and are left out.
+/// In the gap the ends (or the window's opening) alone: the loose gear is free there,
+/// I_L ω_L' = B − C (ω_L − ω_S) moves ω_L monotonically and a = (r_L / I_L)(B − C (ω_L − ω_S))
+/// with it (MODEL.md §3), so |a| peaks at an end. Points outside the current piece (past an
+/// edge the step is redone to end on) are not the piece's and are left out.
 pub(crate) fn step_peak<S: GearPair<N>, D: Dense<N>, const N: usize>(
     sys: &S,
     t0: f64,
@@ -235,8 +250,16 @@ pub(crate) fn step_peak<S: GearPair<N>, D: Dense<N>, const N: usize>(
         Some((t, a)) if t == t0 => a,
         _ => a_at(0.0),
     };
-    let mut points = [(0.0, a0), (0.5, a_at(0.5)), (1.0, a_at(1.0))];
-    let a_end = points[2].1;
+    let a_end = a_at(1.0);
+    if sys.region() == Region::Gap {
+        let first = if t0 < window.from {
+            a_at((window.from - t0) / h)
+        } else {
+            a0
+        };
+        return (first.max(a_end), a_end);
+    }
+    let mut points = [(0.0, a0), (0.5, a_at(0.5)), (1.0, a_end)];
     let mut peak = a0.max(points[1].1).max(a_end);
     for _ in 0..PEAK_ITERATIONS {
         let Some(theta) = parabola_peak(&points)
@@ -275,13 +298,13 @@ fn parabola_peak(p: &[(f64, f64); 3]) -> Option<(f64, f64)> {
     })
 }
 
-impl Jacobian<N> for Rattle {
+impl<const N: usize> Jacobian<N> for KinematicRattle<N> {
     /// ∂f/∂y of `rhs` for Radau IIA: the contact's slopes (MODEL.md §2) through the equation of
     /// motion (§3), ∂ξ''/∂ξ = −(r_L²/I_L) ∂F/∂ξ and ∂ξ''/∂ξ' = −(r_L²/I_L) ∂F/∂ξ' − C/I_L. The
     /// rows of the quadratures (energies, work) are left zero: they do not act back on ξ, ξ',
     /// so Radau's simplified Newton iteration gives them their exact stage values from those
     /// of ξ, ξ' in each iteration, and they are outside the error control.
-    fn jacobian(&self, _t: f64, y: &State) -> [[f64; N]; N] {
+    fn jacobian(&self, _t: f64, y: &[f64; N]) -> [[f64; N]; N] {
         let p = &self.dynamics.params;
         let slopes = self.dynamics.law.slopes(self.region, y[XI], y[XI_DOT]);
         let lever = p.r_L * p.r_L / p.I_L;
@@ -299,8 +322,8 @@ impl Jacobian<N> for Rattle {
 /// pieces are the contact law's regions, and crossing out of the gap counts an impact;
 /// `$extra` items go into the `Piecewise` impl.
 macro_rules! contact_pieces {
-    ($gear:ty, $shaft:item $(, $extra:item)*) => {
-        impl $crate::rattle::GearPair<N> for $gear {
+    ($gear:ident, $shaft:item $(, $extra:item)*) => {
+        impl<const N: usize> $crate::rattle::GearPair<N> for $gear<N> {
             const E_CONTACT: usize = E_CONTACT;
             fn dynamics(&self) -> &$crate::physics::Dynamics {
                 &self.dynamics
@@ -320,7 +343,7 @@ macro_rules! contact_pieces {
             $shaft
         }
 
-        impl $crate::integrator::Piecewise<N> for $gear {
+        impl<const N: usize> $crate::integrator::Piecewise<N> for $gear<N> {
             $($extra)*
 
             const GUARD: usize = XI;
@@ -364,13 +387,13 @@ macro_rules! contact_pieces {
 pub(crate) use contact_pieces;
 
 contact_pieces!(
-    Rattle,
-    fn shaft(&self, t: f64, _y: &State) -> Shaft {
+    KinematicRattle,
+    fn shaft(&self, t: f64, _y: &[f64; N]) -> Shaft {
         self.excitation.at(t)
     },
     /// The gap is crossed in closed form ([`Flight`]): the free flight under the imposed
     /// motion of the main shaft, its start kept for the passage's points.
-    fn exact(&mut self, t0: f64, y0: &State) -> Option<impl ClosedForm<N>> {
+    fn exact(&mut self, t0: f64, y0: &[f64; N]) -> Option<impl ClosedForm<N>> {
         if self.region != Region::Gap {
             return None;
         }
@@ -389,15 +412,15 @@ contact_pieces!(
     },
     /// In full contact, entered through a band (ε > 0, so that δ stays away from the
     /// force's kink): the series of [`ContactSeries`] and the power flows'.
-    fn series(&self, t: f64, y: &State, c: &mut Coefficients<N>) -> bool {
+    fn series(&self, t: f64, y: &[f64; N], c: &mut Coefficients<N>) -> bool {
         self.dynamics.params.epsilon > 0.0 && self.contact_series(t, y, c)
     }
 );
 
-impl Rattle {
+impl<const N: usize> KinematicRattle<N> {
     /// Taylor coefficients of the state in full contact (see [`ContactSeries`]); the
     /// quadratures' are those of their rates (`quadrature_rates`) integrated term by term.
-    fn contact_series(&self, t: f64, y: &State, c: &mut Coefficients<N>) -> bool {
+    fn contact_series(&self, t: f64, y: &[f64; N], c: &mut Coefficients<N>) -> bool {
         let Some(s) = ContactSeries::<{ TERMS + 1 }>::new(
             &self.dynamics,
             &self.excitation,
@@ -428,21 +451,28 @@ impl Rattle {
         let a: [f64; RATES] = std::array::from_fn(|k| {
             lever * (if k == 0 { p.B } else { 0.0 } - p.r_L * force[k] - p.C * slip[k])
         });
-        let contact = math::series_product(&xi_dot, &xi_dot);
-        let lubricant = math::series_product(&slip, &slip);
-        let shaft = math::series_product(&force, &omega_M);
-        let a2 = math::series_product(&a, &a);
-        let f2 = math::series_product(&force, &force);
         c[0][E_CONTACT..].copy_from_slice(&y[E_CONTACT..]);
-        for (k, row) in c.iter_mut().enumerate().skip(1) {
-            // The coefficient k − 1 of each rate, integrated: / k.
-            let inv_k = math::INVERSES[k];
-            row[E_CONTACT] = p.C_LM * contact[k - 1] * inv_k;
-            row[E_LUBRICANT] = p.C * lubricant[k - 1] * inv_k;
-            row[W_SHAFT] = -p.r_M * shaft[k - 1] * inv_k;
-            row[E_CONTACT + quadrature::A2] = a2[k - 1] * inv_k;
-            row[E_CONTACT + quadrature::F1] = force[k - 1] * inv_k;
-            row[E_CONTACT + quadrature::F2] = f2[k - 1] * inv_k;
+        if N > E_CONTACT {
+            let contact = math::series_product(&xi_dot, &xi_dot);
+            let lubricant = math::series_product(&slip, &slip);
+            let shaft = math::series_product(&force, &omega_M);
+            for (k, row) in c.iter_mut().enumerate().skip(1) {
+                // The coefficient k − 1 of each rate, integrated: / k.
+                let inv_k = math::INVERSES[k];
+                row[E_CONTACT] = p.C_LM * contact[k - 1] * inv_k;
+                row[E_LUBRICANT] = p.C * lubricant[k - 1] * inv_k;
+                row[W_SHAFT] = -p.r_M * shaft[k - 1] * inv_k;
+            }
+        }
+        if N > E_CONTACT + quadrature::ENERGIES {
+            let a2 = math::series_product(&a, &a);
+            let f2 = math::series_product(&force, &force);
+            for (k, row) in c.iter_mut().enumerate().skip(1) {
+                let inv_k = math::INVERSES[k];
+                row[E_CONTACT + quadrature::A2] = a2[k - 1] * inv_k;
+                row[E_CONTACT + quadrature::F1] = force[k - 1] * inv_k;
+                row[E_CONTACT + quadrature::F2] = f2[k - 1] * inv_k;
+            }
         }
         true
     }
@@ -457,14 +487,14 @@ fn flight_a2(p: &GearParams, tau: f64, f: &FlightState) -> f64 {
 }
 
 /// The free flight from one start (t0, y0), as the integrator follows it.
-struct FreeFlight<'r, 'y> {
-    rattle: &'r Rattle,
+struct FreeFlight<'r, 'y, const N: usize> {
+    rattle: &'r KinematicRattle<N>,
     start: &'r FlightStart,
     t0: f64,
-    y0: &'y State,
+    y0: &'y [f64; N],
 }
 
-impl FreeFlight<'_, '_> {
+impl<const N: usize> FreeFlight<'_, '_, N> {
     fn flight(&self) -> Flight<'_> {
         let (params, excitation) = (&self.rattle.dynamics.params, &self.rattle.excitation);
         Flight {
@@ -475,14 +505,19 @@ impl FreeFlight<'_, '_> {
     }
 }
 
-impl ClosedForm<N> for FreeFlight<'_, '_> {
-    fn at(&self, t: f64) -> State {
+impl<const N: usize> ClosedForm<N> for FreeFlight<'_, '_, N> {
+    fn at(&self, t: f64) -> [f64; N] {
         let f = self.flight().at(t);
         let mut y = *self.y0;
         y[XI] = f.xi;
         y[XI_DOT] = f.xi_dot;
-        y[E_LUBRICANT] += f.e_lubricant;
-        y[E_CONTACT + quadrature::A2] += flight_a2(&self.rattle.dynamics.params, t - self.t0, &f);
+        if N > E_LUBRICANT {
+            y[E_LUBRICANT] += f.e_lubricant;
+        }
+        if N > E_CONTACT + quadrature::A2 {
+            y[E_CONTACT + quadrature::A2] +=
+                flight_a2(&self.rattle.dynamics.params, t - self.t0, &f);
+        }
         // No contact force in the gap: E_CONTACT, W_SHAFT, ∫F and ∫F² stay.
         y
     }

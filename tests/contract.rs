@@ -6,8 +6,8 @@
 
 use fmi2_shell::values::Values;
 use gear_rattle::contract::{Causality, Kind, STATES, VARIABLES, Variable, vr};
-use gear_rattle::instance::Simulation;
 use gear_rattle::instance::model_exchange::column;
+use gear_rattle::instance::{Carry, Simulation};
 use std::collections::BTreeSet;
 
 /// A simulation in contact on F+ and moving (so that the contact's stiffness and damping
@@ -27,7 +27,7 @@ fn starting_at(excitation: i64, gap_start: f64) -> Simulation {
     values.set_real(vr::alpha_M, 40.0);
     values.set_real(vr::tau_in, 0.5);
     values.set_real(vr::stats_from, 0.0);
-    Simulation::new(&values, 0.0, 0.0, 1e-6).expect("valid parameters")
+    Simulation::new(&values, 0.0, 0.0, 1e-6, Carry::Asked).expect("valid parameters")
 }
 
 fn outputs(kind: Kind) -> impl Iterator<Item = &'static Variable> {
@@ -264,7 +264,7 @@ fn moves(sim: &mut Simulation, v: &Variable, known: u32) -> bool {
 
 /// Each parameter's range as MODEL.md §4 and §5 give it, written out here: the contract's
 /// ranges must refuse a value just outside and admit the bound itself where it is inclusive.
-const RANGES: [(&str, f64, Option<f64>, &str); 13] = [
+const RANGES: [(&str, f64, Option<f64>, &str); 12] = [
     // (name, a value outside, the inclusive bound or None, the range the message states)
     ("I_L", 0.0, None, "I_L > 0"),
     ("r_L", -0.037, None, "r_L > 0"),
@@ -277,7 +277,6 @@ const RANGES: [(&str, f64, Option<f64>, &str); 13] = [
     ("C", -1e-3, Some(0.0), "C >= 0"),
     ("f_exc", 0.0, None, "f_exc > 0"),
     ("I_M", 0.0, None, "I_M > 0"),
-    ("stats_from", -1e-3, Some(0.0), "stats_from >= 0"),
     ("G", f64::INFINITY, None, "G > 0 (finite)"),
 ];
 
@@ -294,7 +293,7 @@ fn parameters_outside_their_range_are_refused_naming_it() {
     for (name, outside, bound, range) in RANGES {
         let mut values = Values::start(VARIABLES);
         values.set_real(real_vr(name), outside);
-        let Err(e) = Simulation::new(&values, 0.0, 0.0, 1e-6) else {
+        let Err(e) = Simulation::new(&values, 0.0, 0.0, 1e-6, Carry::Asked) else {
             panic!("{name} = {outside} accepted");
         };
         let message = e.message;
@@ -305,7 +304,7 @@ fn parameters_outside_their_range_are_refused_naming_it() {
         if let Some(b) = bound {
             values.set_real(real_vr(name), b);
             assert!(
-                Simulation::new(&values, 0.0, 0.0, 1e-6).is_ok(),
+                Simulation::new(&values, 0.0, 0.0, 1e-6, Carry::Asked).is_ok(),
                 "{name} = {b} refused"
             );
         }
@@ -313,12 +312,12 @@ fn parameters_outside_their_range_are_refused_naming_it() {
     // The smallest positive double is inside I_L > 0.
     let mut values = Values::start(VARIABLES);
     values.set_real(vr::I_L, f64::from_bits(1));
-    assert!(Simulation::new(&values, 0.0, 0.0, 1e-6).is_ok());
+    assert!(Simulation::new(&values, 0.0, 0.0, 1e-6, Carry::Asked).is_ok());
     for (name, value) in [("excitation", 3), ("solver", -1)] {
         let mut values = Values::start(VARIABLES);
         let vr = VARIABLES.iter().find(|v| v.name == name).unwrap().vr;
         values.set_integer(vr, value);
-        let Err(e) = Simulation::new(&values, 0.0, 0.0, 1e-6) else {
+        let Err(e) = Simulation::new(&values, 0.0, 0.0, 1e-6, Carry::Asked) else {
             panic!("{name} = {value} accepted");
         };
         let expected = format!("parameter {name} = {value} is invalid: allowed 0 <= {name} <= 2");
@@ -336,7 +335,7 @@ fn the_model_description_states_every_range() {
         let end = start + xml[start..].find("</ScalarVariable>").unwrap();
         &xml[start..end]
     };
-    for (name, _, bound, range) in &RANGES[..12] {
+    for (name, _, bound, range) in &RANGES[..11] {
         let e = element(name);
         let min = match bound {
             Some(b) => format!("min=\"{b:?}\""),

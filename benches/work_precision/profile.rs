@@ -287,7 +287,8 @@ fn call_split(import: &Fmi2Import, sc: &Scene, rtol: f64, integration: f64) {
                 .expect("step");
         }
         rounds[1].push(per_call(start));
-        let mut sim = Simulation::new(&fmu_values(sc), 0.0, 0.0, rtol).expect("simulation");
+        let mut sim =
+            Simulation::new(&fmu_values(sc), 0.0, 0.0, rtol, Carry::Asked).expect("simulation");
         let start = cpu_now();
         for k in 1..=CALLS {
             sim.step_to(k as f64 * 1e-5).expect("step");

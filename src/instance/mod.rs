@@ -7,7 +7,7 @@ pub mod model_exchange;
 pub mod simulation;
 
 pub use fmi2_shell::{FmiError, FmiResult, FmiState, Status};
-pub use simulation::Simulation;
+pub use simulation::{Carry, Simulation};
 
 use crate::contract::{self, Causality, Kind, LOG_CATEGORIES, vr};
 use crate::physics::Shaft;
@@ -80,7 +80,12 @@ impl Instance {
 
     fn build(&self) -> FmiResult<Simulation> {
         let rtol = self.tolerance.unwrap_or(contract::DEFAULT_TOLERANCE);
-        Simulation::new(&self.values, self.tau_in_rate, self.start_time, rtol)
+        // Model Exchange's states are every quadrature of the contract.
+        let carry = match self.interface {
+            Interface::CoSimulation => Carry::Asked,
+            Interface::ModelExchange => Carry::All,
+        };
+        Simulation::new(&self.values, self.tau_in_rate, self.start_time, rtol, carry)
     }
 
     /// The running simulation, or during initialisation one built from the values so far.

@@ -21,7 +21,7 @@ mod jacobian;
 
 pub use jacobian::{Jacobian, column};
 
-use super::simulation::{Drive, Gear, Simulation};
+use super::simulation::{Drive, Gear, Simulation, by_coupling, on_gear};
 use crate::physics::{Dynamics, Excitation, Loads, MainShaft, Polynomial, Region, Shaft};
 use crate::rattle::window::quadrature;
 use crate::rattle::{GearPair, XI, XI_DOT, quadrature_rates, torque};
@@ -68,31 +68,31 @@ impl Simulation {
         let now = self.now();
         let mut x = [0.0; NX];
         (x[0], x[1]) = (now.xi, now.loads(&self.shaft()).omega_L);
-        if let Gear::Torque(k) = &self.gear {
-            (x[2], x[3]) = (k.y[torque::THETA_M], k.y[torque::OMEGA_M]);
-        }
+        by_coupling!(&self.gear, kinematic _ => {},
+            torque k => (x[2], x[3]) = (k.y[torque::THETA_M], k.y[torque::OMEGA_M]));
         x[4..].copy_from_slice(&now.quadratures);
         x
     }
 
-    /// Takes the importer's states x: ξ' follows from ω_L and the shaft's speed now.
+    /// Takes the importer's states x: ξ' follows from ω_L and the shaft's speed now. (Model
+    /// Exchange's simulation carries every quadrature, [`Carry::All`](super::Carry::All).)
     pub fn set_continuous_states(&mut self, x: &[f64; NX]) {
-        match &mut self.gear {
-            Gear::Kinematic(k) => {
-                let p = &k.system.dynamics.params;
-                let omega_M = k.system.excitation.at(self.t).omega;
-                k.y[XI] = x[0];
-                k.y[XI_DOT] = p.r_L * x[1] - p.r_M * omega_M;
-                k.y[crate::rattle::E_CONTACT..].copy_from_slice(&x[4..]);
-            }
-            Gear::Torque(k) => {
-                let p = &k.system.dynamics.params;
-                k.y[XI] = x[0];
-                k.y[XI_DOT] = p.r_L * x[1] - p.r_M * x[3];
-                (k.y[torque::THETA_M], k.y[torque::OMEGA_M]) = (x[2], x[3]);
-                k.y[torque::E_CONTACT..].copy_from_slice(&x[4..]);
-            }
-        }
+        let t = self.t;
+        by_coupling!(&mut self.gear, kinematic k => {
+            let p = &k.system.dynamics.params;
+            let omega_M = k.system.excitation.at(t).omega;
+            k.y[XI] = x[0];
+            k.y[XI_DOT] = p.r_L * x[1] - p.r_M * omega_M;
+            let q = k.y.len() - crate::rattle::E_CONTACT;
+            k.y[crate::rattle::E_CONTACT..].copy_from_slice(&x[4..4 + q]);
+        }, torque k => {
+            let p = &k.system.dynamics.params;
+            k.y[XI] = x[0];
+            k.y[XI_DOT] = p.r_L * x[1] - p.r_M * x[3];
+            (k.y[torque::THETA_M], k.y[torque::OMEGA_M]) = (x[2], x[3]);
+            let q = k.y.len() - torque::E_CONTACT;
+            k.y[torque::E_CONTACT..].copy_from_slice(&x[4..4 + q]);
+        })
     }
 
     /// The right-hand side's operating point at the current time and states, with the
@@ -101,26 +101,23 @@ impl Simulation {
         let now = self.now();
         let (dynamics, xi, xi_dot) = (now.dynamics, now.xi, now.xi_dot);
         let region = dynamics.law.classify(xi);
-        let (loads, shaft, shaft_from) = match &self.gear {
-            Gear::Kinematic(k) => {
-                let shaft = k.system.excitation.at(self.t);
-                let shaft_from = match self.drive {
-                    Drive::Inputs(_) => ShaftFrom::Inputs,
-                    _ => ShaftFrom::Time,
-                };
-                (
-                    dynamics.loads(region, xi, xi_dot, &shaft),
-                    shaft,
-                    shaft_from,
-                )
-            }
-            Gear::Torque(k) => {
-                let mut system = k.system;
-                system.region = region;
-                let (loads, shaft) = system.loads(self.t, &k.y);
-                (loads, shaft, ShaftFrom::States(k.system.main))
-            }
-        };
+        let (loads, shaft, shaft_from) = by_coupling!(&self.gear, kinematic k => {
+            let shaft = k.system.excitation.at(self.t);
+            let shaft_from = match self.drive {
+                Drive::Inputs(_) => ShaftFrom::Inputs,
+                _ => ShaftFrom::Time,
+            };
+            (
+                dynamics.loads(region, xi, xi_dot, &shaft),
+                shaft,
+                shaft_from,
+            )
+        }, torque k => {
+            let mut system = k.system;
+            system.region = region;
+            let (loads, shaft) = system.loads(self.t, &k.y);
+            (loads, shaft, ShaftFrom::States(k.system.main))
+        });
         Point {
             dynamics,
             region,
@@ -212,14 +209,15 @@ impl Simulation {
     }
 
     fn hold_inputs(&mut self) {
-        if let (Drive::Inputs(shaft), Gear::Kinematic(k)) = (self.drive, &mut self.gear) {
-            k.system.excitation = Excitation::Polynomial(Polynomial {
+        if let Drive::Inputs(shaft) = self.drive {
+            let excitation = Excitation::Polynomial(Polynomial {
                 t0: self.t,
                 at_t0: Shaft {
                     alpha: 0.0,
                     ..shaft
                 },
             });
+            by_coupling!(&mut self.gear, kinematic k => k.system.excitation = excitation, torque _ => {});
         }
     }
 
@@ -228,19 +226,13 @@ impl Simulation {
     /// come. Returns the next time event: the window's opening, if still ahead.
     pub fn update_discrete_states(&mut self) -> Option<f64> {
         let t = self.t;
-        match &mut self.gear {
-            Gear::Kinematic(k) => k.update_discrete_states(t),
-            Gear::Torque(k) => k.update_discrete_states(t),
-        }
+        on_gear!(&mut self.gear, k => k.update_discrete_states(t))
     }
 
     /// After an accepted step of the importer: |a| there for the statistics' peak.
     pub fn completed_integrator_step(&mut self) {
         let t = self.t;
-        match &mut self.gear {
-            Gear::Kinematic(k) => k.sample_acceleration(t),
-            Gear::Torque(k) => k.sample_acceleration(t),
-        }
+        on_gear!(&mut self.gear, k => k.sample_acceleration(t))
     }
 
     /// A Real output as Model Exchange reads it: the contact's loads, and the torque mode's

@@ -1,9 +1,10 @@
 //! The running model of an initialised instance: the gear pair with its solver and state,
 //! the clock, and what drives the main shaft. Two couplings: kinematic (the shaft's motion
-//! imposed by the bench sine or the master's inputs; the 5-component [`Rattle`]) and torque
-//! (the shaft an inertia driven by the master's torque; the 7-component [`TorqueRattle`]),
-//! each with a solver of its own size, so the kinematic modes carry no extra state.
-//! Outputs are computed here when they are read, by one code for both couplings ([`Now`]).
+//! imposed by the bench sine or the master's inputs; [`Rattle`], or [`LeanRattle`] without
+//! the statistics window's quadratures when a run asks for no window) and torque (the shaft
+//! an inertia driven by the master's torque; [`TorqueRattle`], two states more), each with a
+//! solver of its own size: a state carries only what its run needs. Outputs are computed
+//! here when they are read, by one code for every variant ([`Now`]).
 #![allow(non_snake_case)]
 
 use serde::{Deserialize, Serialize};
@@ -16,7 +17,7 @@ use crate::physics::{
 };
 use crate::rattle::torque::{self, TorqueRattle};
 use crate::rattle::window::{Metrics, Quadratures, Window, quadrature};
-use crate::rattle::{self, GearPair, Impacts, Rattle};
+use crate::rattle::{self, GearPair, Impacts, KinematicRattle, LeanRattle, Rattle};
 use fmi2_shell::values::Values;
 
 /// Values of the `excitation` parameter.
@@ -65,6 +66,23 @@ impl<S: GearPair<N> + Jacobian<N> + Copy, const N: usize> Stepped<S, N> {
         advanced
     }
 
+    /// The pair at t0 with the state's first components `head` (the quadratures from 0) and
+    /// its statistics window opening at `window`, if any: a window that opens at t0 keeps
+    /// the initial quadratures.
+    fn start(system: S, solver: Solver<N>, head: &[f64], t0: f64, window: Option<f64>) -> Self {
+        let system = match window {
+            Some(from) => system.with_window(t0, from),
+            None => system,
+        };
+        let mut y = [0.0; N];
+        y[..head.len()].copy_from_slice(head);
+        let mut stepped = Stepped { system, solver, y };
+        if stepped.system.window().from <= t0 {
+            stepped.open_window();
+        }
+        stepped
+    }
+
     /// The statistics window opens now: its quadratures are kept.
     pub(super) fn open_window(&mut self) {
         let q = S::quadratures(&self.y);
@@ -102,16 +120,72 @@ impl<S: GearPair<N> + Jacobian<N> + Copy, const N: usize> Stepped<S, N> {
     }
 }
 
-/// The gear pair in one of the two couplings. Plain data kept in place (it is copied whole
-/// for a rollback and serialized for the FMU state), so the torque variant's two more states
-/// are not boxed.
+impl<const N: usize> Stepped<KinematicRattle<N>, N> {
+    /// A kinematic pair at t0 (see [`Stepped::start`]) with its solver at `rtol`; `ends`:
+    /// the end times of the calls are served from the dense output of natural steps.
+    fn kinematic(
+        system: KinematicRattle<N>,
+        rtol: f64,
+        method: Method,
+        ends: bool,
+        head: &[f64],
+        t0: f64,
+        window: Option<f64>,
+    ) -> Self {
+        let mut solver = Solver::with_method(system.tolerance(rtol), method);
+        solver.interpolate_ends = ends;
+        Self::start(system, solver, head, t0, window)
+    }
+}
+
+/// The gear pair in one of the two couplings, with the statistics window's quadratures or
+/// without. Plain data kept in place (it is copied whole for a rollback and serialized for
+/// the FMU state), so the larger variants are not boxed.
 #[allow(clippy::large_enum_variant)]
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub enum Gear {
     /// The main shaft's motion imposed (sine or inputs): state ξ, ξ' and the quadratures.
     Kinematic(Stepped<Rattle, { rattle::N }>),
+    /// The same without the window's quadratures.
+    KinematicLean(Stepped<LeanRattle, { rattle::N_LEAN }>),
     /// The main shaft an inertia driven by τ_in: θ_M and ω_M join the state.
     Torque(Stepped<TorqueRattle, { torque::N }>),
+}
+
+/// `$body` with `$k` the stepped pair of `$gear`, whichever the variant (compiled for each:
+/// their types differ in the state's size).
+macro_rules! on_gear {
+    ($gear:expr, $k:ident => $body:expr) => {
+        match $gear {
+            Gear::Kinematic($k) => $body,
+            Gear::KinematicLean($k) => $body,
+            Gear::Torque($k) => $body,
+        }
+    };
+}
+pub(super) use on_gear;
+
+/// `$kinematic` or `$torque` by the coupling of `$gear`, each with its pattern bound to the
+/// stepped pair.
+macro_rules! by_coupling {
+    ($gear:expr, kinematic $kp:pat => $kinematic:expr, torque $tp:pat => $torque:expr) => {
+        match $gear {
+            Gear::Kinematic($kp) => $kinematic,
+            Gear::KinematicLean($kp) => $kinematic,
+            Gear::Torque($tp) => $torque,
+        }
+    };
+}
+pub(super) use by_coupling;
+
+/// Which of the quadratures a simulation carries.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Carry {
+    /// Those its run asks for: all of them with a statistics window, the energies and the
+    /// work alone without in the kinematic modes (co-simulation).
+    Asked,
+    /// All of them: Model Exchange, whose importer integrates every state of the contract.
+    All,
 }
 
 /// An initialised gear pair being stepped.
@@ -187,7 +261,14 @@ impl Simulation {
     /// ξ(0) = gap_start·G, ξ'(0) = xi_dot_start; in torque mode the shaft starts from the
     /// values of the inputs theta_M and omega_M, θ_M(0) = theta_M, ω_M(0) = omega_M, and
     /// τ_in ramps at `tau_in_rate`, the derivative fmi2SetRealInputDerivatives gave).
-    pub fn new(values: &Values, tau_in_rate: f64, t0: f64, rtol: f64) -> FmiResult<Self> {
+    /// The state carries the quadratures `carry` says.
+    pub fn new(
+        values: &Values,
+        tau_in_rate: f64,
+        t0: f64,
+        rtol: f64,
+        carry: Carry,
+    ) -> FmiResult<Self> {
         contract::check_parameters(values)?;
         let params = gear_params(values);
         let f_exc = param(values, vr::f_exc);
@@ -214,6 +295,12 @@ impl Simulation {
         let method = method(values);
         let dynamics = Dynamics::new(params);
         let xi = gap_start * params.G;
+        // A negative stats_from opens no window: the kinematic state then carries none of its
+        // quadratures, unless Model Exchange's contract has them as states. The torque mode
+        // carries them always: its Jacobian's rows for them are not zero, so Radau IIA's
+        // pivoting, and with it the trajectory's last bits, depends on them.
+        let window = (stats_from >= 0.0).then_some(stats_from);
+        let all = window.is_some() || carry == Carry::All;
         let gear = match drive {
             Drive::Torque { tau, rate } => {
                 let ramp = TorqueRamp {
@@ -221,41 +308,32 @@ impl Simulation {
                     tau0: tau,
                     rate,
                 };
-                let system = TorqueRattle::new(dynamics, MainShaft { I_M }, ramp, xi)
-                    .with_window(t0, stats_from);
-                let mut y = [0.0; torque::N];
-                y[torque::XI] = xi;
-                y[torque::XI_DOT] = xi_dot_start;
-                y[torque::THETA_M] = shaft.theta;
-                y[torque::OMEGA_M] = shaft.omega;
-                Gear::Torque(Stepped {
-                    solver: Solver::with_method(system.tolerance(rtol), method),
-                    system,
-                    y,
-                })
+                let head = [xi, xi_dot_start, shaft.theta, shaft.omega];
+                let system = TorqueRattle::new(dynamics, MainShaft { I_M }, ramp, xi);
+                let solver = Solver::with_method(system.tolerance(rtol), method);
+                Gear::Torque(Stepped::start(system, solver, &head, t0, window))
             }
             _ => {
                 let excitation = Self::excitation_from(drive, t0);
-                let system = Rattle::new(dynamics, excitation, xi).with_window(t0, stats_from);
-                let mut y = [0.0; rattle::N];
-                y[rattle::XI] = xi;
-                y[rattle::XI_DOT] = xi_dot_start;
-                let mut solver = Solver::with_method(system.tolerance(rtol), method);
+                let head = [xi, xi_dot_start];
                 // The bench's sine does not change between steps: communication points are
                 // served from the dense output of natural steps. Inputs change at every step:
                 // steps end on the communication points, where the new inputs apply.
-                solver.interpolate_ends = matches!(drive, Drive::Sine(_));
-                Gear::Kinematic(Stepped { solver, system, y })
+                let ends = matches!(drive, Drive::Sine(_));
+                if all {
+                    let system = Rattle::new(dynamics, excitation, xi);
+                    Gear::Kinematic(Stepped::kinematic(
+                        system, rtol, method, ends, &head, t0, window,
+                    ))
+                } else {
+                    let system = LeanRattle::new(dynamics, excitation, xi);
+                    Gear::KinematicLean(Stepped::kinematic(
+                        system, rtol, method, ends, &head, t0, window,
+                    ))
+                }
             }
         };
-        let mut sim = Simulation { gear, t: t0, drive };
-        // A window that opens at the start keeps the initial quadratures.
-        match &mut sim.gear {
-            Gear::Kinematic(k) if k.system.window.from <= t0 => k.open_window(),
-            Gear::Torque(k) if k.system.window.from <= t0 => k.open_window(),
-            _ => {}
-        }
-        Ok(sim)
+        Ok(Simulation { gear, t: t0, drive })
     }
 
     /// The imposed motion of the shaft for a kinematic drive.
@@ -272,18 +350,12 @@ impl Simulation {
 
     /// The state the outputs are computed from, now.
     pub(super) fn now(&self) -> Now<'_> {
-        match &self.gear {
-            Gear::Kinematic(k) => k.now(),
-            Gear::Torque(k) => k.now(),
-        }
+        on_gear!(&self.gear, k => k.now())
     }
 
     /// The main shaft's motion now (in torque mode α_M follows from τ_in and the contact).
     pub fn shaft(&self) -> Shaft {
-        match &self.gear {
-            Gear::Kinematic(k) => k.system.shaft(self.t, &k.y),
-            Gear::Torque(k) => k.system.shaft(self.t, &k.y),
-        }
+        on_gear!(&self.gear, k => k.system.shaft(self.t, &k.y))
     }
 
     /// Impacts counted so far.
@@ -303,55 +375,57 @@ impl Simulation {
 
     /// Step size the next internal step will try.
     pub fn proposed_step(&self) -> f64 {
-        match &self.gear {
-            Gear::Kinematic(k) => k.solver.proposed_step(),
-            Gear::Torque(k) => k.solver.proposed_step(),
-        }
+        on_gear!(&self.gear, k => k.solver.proposed_step())
     }
 
     /// New input values for the main shaft (inputs mode). The loose gear does not move, so
     /// ξ and ξ' follow the shaft (ξ = r_L θ_L − r_M θ_M): reading them right after reflects
     /// the new inputs (direct feedthrough). In the other modes the inputs are not used.
     pub fn set_shaft(&mut self, shaft: Shaft) {
-        let (Drive::Inputs(old), Gear::Kinematic(k)) = (self.drive, &mut self.gear) else {
+        let Drive::Inputs(old) = self.drive else {
             return;
         };
-        let r_M = k.system.dynamics.params.r_M;
-        k.y[rattle::XI] += r_M * (old.theta - shaft.theta);
-        k.y[rattle::XI_DOT] += r_M * (old.omega - shaft.omega);
         self.drive = Drive::Inputs(shaft);
-        k.system.excitation = Self::excitation_from(self.drive, self.t);
-        k.system.settle(self.t, &k.y);
-        k.solver.invalidate();
+        let (t, excitation) = (self.t, Self::excitation_from(self.drive, self.t));
+        by_coupling!(&mut self.gear, kinematic k => {
+            let r_M = k.system.dynamics.params.r_M;
+            k.y[rattle::XI] += r_M * (old.theta - shaft.theta);
+            k.y[rattle::XI_DOT] += r_M * (old.omega - shaft.omega);
+            k.system.excitation = excitation;
+            k.system.settle(t, &k.y);
+            k.solver.invalidate();
+        }, torque _ => {})
     }
 
     /// New torque on the main shaft and its rate (torque mode; ignored otherwise). The state
     /// does not jump: only the shaft's acceleration, read at once as alpha_M_out, changes.
     pub fn set_torque(&mut self, tau: f64, rate: f64) {
-        let (Drive::Torque { .. }, Gear::Torque(k)) = (self.drive, &mut self.gear) else {
+        let Drive::Torque { .. } = self.drive else {
             return;
         };
         self.drive = Drive::Torque { tau, rate };
-        k.system.torque = TorqueRamp {
+        let ramp = TorqueRamp {
             t0: self.t,
             tau0: tau,
             rate,
         };
-        k.solver.invalidate();
+        by_coupling!(&mut self.gear, kinematic _ => {}, torque k => {
+            k.system.torque = ramp;
+            k.solver.invalidate();
+        })
     }
 
     /// Advances to t_end. On failure the simulation is left as it was.
     pub fn step_to(&mut self, t_end: f64) -> Result<(), SolverError> {
-        match &mut self.gear {
-            Gear::Kinematic(k) => k.advance(&mut self.t, t_end)?,
-            Gear::Torque(k) => k.advance(&mut self.t, t_end)?,
-        }
+        on_gear!(&mut self.gear, k => k.advance(&mut self.t, t_end)?);
         self.t = t_end;
         // The inputs continue along their extrapolation unless the master sets new ones.
-        match (&mut self.drive, &self.gear) {
-            (Drive::Inputs(shaft), Gear::Kinematic(k)) => *shaft = k.system.excitation.at(t_end),
-            (Drive::Torque { tau, .. }, Gear::Torque(k)) => *tau = k.system.torque.at(t_end),
-            _ => {}
+        match &mut self.drive {
+            Drive::Inputs(shaft) => by_coupling!(&self.gear,
+                kinematic k => *shaft = k.system.excitation.at(t_end), torque _ => {}),
+            Drive::Torque { tau, .. } => by_coupling!(&self.gear,
+                kinematic _ => {}, torque k => *tau = k.system.torque.at(t_end)),
+            Drive::Sine(_) => {}
         }
         Ok(())
     }
@@ -428,15 +502,17 @@ impl Simulation {
     /// ∂output/∂input at the current state: how an output read right after new inputs moves
     /// with them (direct feedthrough). Zero for inputs the current excitation does not use.
     pub fn partial(&self, output: u32, input: u32) -> f64 {
-        match (self.drive, &self.gear) {
-            (Drive::Inputs(_), _) => self.kinematic_partial(output, input),
+        match self.drive {
+            Drive::Inputs(_) => self.kinematic_partial(output, input),
             // Torque mode: τ_in moves only the shaft's acceleration at once,
             // α_M = (τ_in + τ_M) / I_M; the state (ξ, ξ', θ_M, ω_M) does not jump.
-            (Drive::Torque { .. }, Gear::Torque(k)) => match (output, input) {
-                (vr::alpha_M_out, vr::tau_in) => 1.0 / k.system.main.I_M,
+            Drive::Torque { .. } => match (output, input) {
+                (vr::alpha_M_out, vr::tau_in) => {
+                    by_coupling!(&self.gear, kinematic _ => 0.0, torque k => 1.0 / k.system.main.I_M)
+                }
                 _ => 0.0,
             },
-            _ => 0.0,
+            Drive::Sine(_) => 0.0,
         }
     }
 
@@ -529,4 +605,51 @@ fn stat_integer(m: &Metrics, vr: u32) -> Option<i64> {
         vr::stat_side => side,
         _ => return None,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// S1 over 0.2 s in steps of 1 ms, in the sine and the inputs modes (held inputs), with
+    /// the automatic choice and with Radau IIA throughout: a run without a window (the state
+    /// without the window's quadratures) and one whose window opens after its end (every
+    /// quadrature carried) give the same ξ, ξ', impacts, solver counters and energies, to the
+    /// last bit.
+    #[test]
+    fn a_run_without_window_steps_the_same_trajectory() {
+        let run = |(excitation, solver): (i64, i64), stats_from: f64| {
+            let mut values = Values::start(crate::contract::VARIABLES);
+            values.set_integer(vr::excitation, excitation);
+            values.set_integer(vr::solver, solver);
+            values.set_real(vr::omega_M, 30.0);
+            values.set_real(vr::stats_from, stats_from);
+            let mut sim = Simulation::new(&values, 0.0, 0.0, 1e-6, Carry::Asked).unwrap();
+            for k in 1..=200 {
+                sim.step_to(k as f64 * 1e-3).unwrap();
+            }
+            let outputs = [
+                vr::xi,
+                vr::xi_dot,
+                vr::E_contact,
+                vr::E_lubricant,
+                vr::solver_steps,
+                vr::solver_rhs,
+            ]
+            .map(|v| sim.real_output(v).unwrap().to_bits());
+            let lean = matches!(sim.gear, Gear::KinematicLean(_));
+            (lean, outputs, sim.impacts().count)
+        };
+        for case in [
+            (EXCITATION_SINE, 0),
+            (EXCITATION_INPUTS, 0),
+            (EXCITATION_SINE, 2),
+        ] {
+            let (lean, outputs, impacts) = run(case, -1.0);
+            let (all, outputs_all, impacts_all) = run(case, 1.0);
+            assert!(lean && !all, "{case:?}");
+            assert!(impacts[0] + impacts[1] > 0, "{case:?}: {impacts:?}");
+            assert_eq!((outputs, impacts), (outputs_all, impacts_all), "{case:?}");
+        }
+    }
 }

@@ -9,8 +9,8 @@
 //!
 //! State: ξ, ξ' and θ_M, ω_M (under error control), then the quadratures of
 //! [`crate::rattle::window::quadrature`]: E_contact, E_lubricant, the work
-//! W_shaft = ∫ −τ_M ω_M dt the shaft feeds into the loose gear, ∫a² dt, ∫F dt and ∫F² dt. The regions, edges and impact counts are those of the
-//! kinematic [`Rattle`](super::Rattle).
+//! W_shaft = ∫ −τ_M ω_M dt the shaft feeds into the loose gear, ∫a² dt, ∫F dt and ∫F² dt.
+//! The regions, edges and impact counts are those of the kinematic [`Rattle`](super::Rattle).
 #![allow(non_snake_case)]
 
 use serde::{Deserialize, Serialize};
@@ -35,9 +35,13 @@ pub const N: usize = E_CONTACT + quadrature::COUNT;
 
 pub type State = [f64; N];
 
+/// The torque-driven pair with its `N`-component state (the gear pairs' common code,
+/// `contact_pieces!`, is written for any size).
+pub type TorqueRattle = DrivenRattle<N>;
+
 /// The gear pair, the region it is in, the main shaft's inertia and the torque driving it.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub struct TorqueRattle {
+pub struct DrivenRattle<const N: usize> {
     pub dynamics: Dynamics,
     pub main: MainShaft,
     pub region: Region,
@@ -46,12 +50,12 @@ pub struct TorqueRattle {
     pub window: Window,
 }
 
-impl TorqueRattle {
+impl<const N: usize> DrivenRattle<N> {
     /// The pair at ξ, with no statistics window (one opens with
     /// [`GearPair::with_window`](super::GearPair::with_window)).
     pub fn new(dynamics: Dynamics, main: MainShaft, torque: TorqueRamp, xi: f64) -> Self {
         let region = dynamics.law.classify(xi);
-        TorqueRattle {
+        DrivenRattle {
             region,
             dynamics,
             main,
@@ -84,7 +88,7 @@ impl TorqueRattle {
 
     /// Loads on the gear pair and the main shaft's motion (with its acceleration) at (t, y).
     #[inline]
-    pub fn loads(&self, t: f64, y: &State) -> (Loads, Shaft) {
+    pub fn loads(&self, t: f64, y: &[f64; N]) -> (Loads, Shaft) {
         self.dynamics.driven_loads(
             self.region,
             y[XI],
@@ -97,25 +101,25 @@ impl TorqueRattle {
     }
 }
 
-impl System<N> for TorqueRattle {
+impl<const N: usize> System<N> for DrivenRattle<N> {
     #[inline]
-    fn rhs(&self, t: f64, y: &State) -> State {
+    fn rhs(&self, t: f64, y: &[f64; N]) -> [f64; N] {
         let (loads, shaft) = self.loads(t, y);
         let q = quadrature_rates(&self.dynamics.params, &loads, y[XI_DOT], shaft.omega);
         let mut f = [0.0; N];
         f[..E_CONTACT].copy_from_slice(&[y[XI_DOT], loads.xi_ddot, shaft.omega, shaft.alpha]);
-        f[E_CONTACT..].copy_from_slice(&q);
+        f[E_CONTACT..].copy_from_slice(&q[..N - E_CONTACT]);
         f
     }
 }
 
-impl Jacobian<N> for TorqueRattle {
+impl<const N: usize> Jacobian<N> for DrivenRattle<N> {
     /// ∂f_i/∂y_j from the equations of the module with F_ξ = ∂F/∂ξ, F_v = ∂F/∂ξ'
     /// ([`ContactLaw::slopes`](crate::physics::ContactLaw::slopes)):
     /// ∂ξ''/∂ξ = −k F_ξ, ∂ξ''/∂ξ' = −k F_v − C/I_L, ∂ξ''/∂ω_M = −C r_M/I_L with
     /// k = r_L²/I_L + r_M²/I_M; ∂ω_M'/∂ξ = r_M F_ξ/I_M, ∂ω_M'/∂ξ' = r_M F_v/I_M; θ_M and the
     /// quadratures enter no right-hand side. The quadratures' rows follow from their rates.
-    fn jacobian(&self, t: f64, y: &State) -> [[f64; N]; N] {
+    fn jacobian(&self, t: f64, y: &[f64; N]) -> [[f64; N]; N] {
         let p = &self.dynamics.params;
         let (xi, xi_dot, omega_M) = (y[XI], y[XI_DOT], y[OMEGA_M]);
         let (loads, _) = self.loads(t, y);
@@ -167,8 +171,8 @@ impl Jacobian<N> for TorqueRattle {
 }
 
 contact_pieces!(
-    TorqueRattle,
-    fn shaft(&self, t: f64, y: &State) -> Shaft {
+    DrivenRattle,
+    fn shaft(&self, t: f64, y: &[f64; N]) -> Shaft {
         self.loads(t, y).1
     }
 );

@@ -11,7 +11,8 @@ use crate::physics::Region;
 
 /// The quadratures of a gear pair's state, in this order from its `E_CONTACT` component on:
 /// the energies of MODEL.md §3's balance, then the integrals behind the RMS and the standard
-/// deviation of the window.
+/// deviation of the window (carried only by a pair with a window: the first [`ENERGIES`]
+/// are the state of a pair without).
 pub mod quadrature {
     /// ∫ F_c ξ' dt: energy dissipated in the contact damping [J].
     pub const E_CONTACT: usize = 0;
@@ -19,6 +20,8 @@ pub mod quadrature {
     pub const E_LUBRICANT: usize = 1;
     /// ∫ −τ_M ω_M dt: work the main shaft feeds into the loose gear [J].
     pub const W_SHAFT: usize = 2;
+    /// The energies and the work: the quadratures every pair carries.
+    pub const ENERGIES: usize = 3;
     /// ∫ a² dt, a = r_L α_L the pitch-line acceleration [m²/s³].
     pub const A2: usize = 3;
     /// ∫ F dt [N s].

@@ -65,6 +65,29 @@ def test_statistics_match_the_reference(unzipdir, model_description, references,
     assert max(err.values()) <= 1e-4, {n: f"{e:.1e}" for n, e in err.items() if e > 1e-4}
 
 
+def test_without_stats_from_no_window_yet_the_energies(unzipdir, model_description, references):
+    """S1 with stats_from left at its default (no window; the state then carries none of the
+    window's integrals): every stat_* output reads 0, as the contract documents, while the
+    energies are integrated all the same: E_contact and E_lubricant gained over [0.1, 0.5] are
+    the independent reference's powers times 0.4 s, within 1e-4. The same run with the window
+    asked for gives the reference's statistics, not zeros."""
+    want = references("S1")
+    t0, t1 = WINDOWS["S1"]
+    sc = R.SCENES["S1"]
+    names = [v.name for v in model_description.modelVariables if v.name.startswith("stat_")]
+    res = simulate_fmu(unzipdir, model_description=model_description, stop_time=t1,
+                       start_values={"excitation": 1, "f_exc": sc["f_exc"], "A_rms": sc["A_rms"]},
+                       step_size=t0, output_interval=t0, output=names + ["E_contact", "E_lubricant"])
+    assert res["time"][1] == pytest.approx(t0) and res["time"][-1] == pytest.approx(t1)
+    assert {n: res[n][-1] for n in names} == {n: 0 for n in names}
+    for energy, power in (("E_contact", "stat_P_contact"), ("E_lubricant", "stat_P_lubricant")):
+        gained = res[energy][-1] - res[energy][1]
+        assert gained == pytest.approx(want[power] * (t1 - t0), rel=1e-4), energy
+    got = stats_at_end(unzipdir, model_description, "S1", t0, t1)
+    assert got["stat_impacts_Fplus"] == want["stat_impacts_Fplus"] > 0
+    assert got["stat_a_rms"] == pytest.approx(want["stat_a_rms"], rel=1e-4)
+
+
 def test_tighter_tolerance_comes_closer(unzipdir, model_description, references):
     """At rtol 1e-9 the speeds, integrals and powers on S1 agree to 1e-6."""
     want = references("S1")

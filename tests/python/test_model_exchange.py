@@ -152,7 +152,8 @@ MODES = {
     "sine": dict(excitation=1),
     "torque": dict(excitation=2, tau_in=2.0, omega_M=83.0),
 }
-PHYSICS = dict(B=0.3, omega_S=12.0, xi_dot_start=0.02)
+# The statistics window open from the start, so that the stat_* outputs' partials are checked.
+PHYSICS = dict(B=0.3, omega_S=12.0, xi_dot_start=0.02, stats_from=0.0)
 # ξ in contact on F+, in its band, in the gap, in F-'s band, in contact on F-.
 XIS = [-3e-6, -0.6e-6, 10e-6, G + 0.3e-6, G + 4e-6]
 

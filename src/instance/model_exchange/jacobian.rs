@@ -216,8 +216,8 @@ fn over_quadratures(row: &Quadratures) -> Gradient {
 mod tests {
     use super::*;
     use crate::contract::VARIABLES;
-    use crate::instance::Simulation;
     use crate::instance::simulation::{EXCITATION_INPUTS, EXCITATION_SINE, EXCITATION_TORQUE};
+    use crate::instance::{Carry, Simulation};
     use crate::physics::{GearParams, Shaft};
     use fmi2_shell::values::Values;
 
@@ -247,7 +247,8 @@ mod tests {
         ] {
             values.set_real(v, value);
         }
-        let mut sim = Simulation::new(&values, 0.0, 0.0, 1e-6).expect("valid parameters");
+        let mut sim =
+            Simulation::new(&values, 0.0, 0.0, 1e-6, Carry::All).expect("valid parameters");
         sim.set_time(T).expect("a finite shaft at T");
         sim.set_shaft_inputs(shaft);
         sim.set_torque(tau, TAU.1);
