@@ -13,7 +13,8 @@
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
-use std::{env, fs, path::PathBuf};
+use std::path::{Path, PathBuf};
+use std::{env, fs};
 
 #[derive(Deserialize)]
 struct Contract {
@@ -88,12 +89,17 @@ impl Variable {
 /// Generates the model description and the Rust constants of the contract at `path`
 /// (relative to the crate's manifest directory), and asks cargo to rerun when it changes.
 pub fn generate(path: &str) {
+    generate_in(path, &PathBuf::from(env::var("OUT_DIR").unwrap()));
+}
+
+/// [`generate`] into the directory `out`: the packaging crate's build script writes each
+/// model's files into a folder of its own.
+pub fn generate_in(path: &str, out: &Path) {
     println!("cargo:rerun-if-changed={path}");
     let text = fs::read_to_string(path).unwrap_or_else(|e| panic!("{path}: {e}"));
     let contract: Contract = toml::from_str(&text).unwrap_or_else(|e| panic!("{path}: {e}"));
     check(&contract);
     let guid = guid_of(&text);
-    let out = PathBuf::from(env::var("OUT_DIR").unwrap());
     fs::write(out.join("modelDescription.xml"), xml(&contract, &guid)).unwrap();
     fs::write(out.join("contract.rs"), rust(&contract, &guid)).unwrap();
 }
