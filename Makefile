@@ -46,9 +46,10 @@ demo: fmu $(VENV)/.installed
 ## test: every test: Rust (cargo test) and the FMU as a user runs it (pytest + fmpy)
 test: $(TEST_TARGETS)
 
-# The C-API tests load the cdylib, which `cargo test` alone does not produce.
+# The C-API tests load the cdylib, which `cargo test` alone does not produce. fmi2-shell's
+# own tests check FMI's rules on a model of their own.
 test-rust: $(LIB) | libclang
-	cargo test --release
+	cargo test --release -p gear_rattle -p fmi2-shell
 
 test-python: fmu $(VENV)/.installed
 	$(PY) -m pytest -q
