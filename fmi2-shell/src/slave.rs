@@ -10,7 +10,8 @@ use crate::status::{FmiError, FmiResult};
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 
-/// Who a model is: what fmi2Instantiate checks and what tags its FMU states.
+/// Who a model is: what fmi2Instantiate checks, what tags its FMU states, where its
+/// variables are looked up.
 pub struct Identity {
     /// The GUID of the model description the binary was built with.
     pub guid: &'static str,
@@ -18,7 +19,7 @@ pub struct Identity {
     /// Log categories, errors first, then warnings ([`Log`]).
     pub log_categories: Categories,
     /// First bytes of a serialized FMU state, and its format's version (raised whenever the
-    /// slave's serialized shape changes).
+    /// serialized shape of the instance, the shell's part or the slave's, changes).
     pub state_magic: [u8; 4],
     pub state_version: u16,
     /// Whether the model offers Model Exchange besides Co-Simulation.
