@@ -1,5 +1,5 @@
 //! GearRattle: the gear-pair rattle model of Dion, Le Moyne, Chevallier and Sebbah (MSSP
-//! 2009) as an FMI 2.0 Co-Simulation FMU.
+//! 2009) as an FMI 2.0 FMU for Co-Simulation and Model Exchange.
 //!
 //! Layers, each knowing nothing of the ones above it:
 //! - [`math`]: cheap elementary functions for the right-hand side (cube root, sine);
@@ -9,8 +9,8 @@
 //!   dense outputs, the hand-over between them, and edge location;
 //! - [`rattle`]: the gear pair as a piecewise ODE for the integrator, with impact counting
 //!   (the shaft's motion imposed; [`rattle::torque`]: driven by a torque, 7 states);
-//! - [`instance`]: the slave of fmi2-shell (variables, stepping, Model Exchange's equations;
-//!   the shell applies FMI's rules around it);
+//! - [`instance`]: the slave of fmi2-shell (variables, co-simulation stepping, Model
+//!   Exchange's states and events; the shell applies FMI's rules around it);
 //! - the `fmi2*` C exports of Co-Simulation and Model Exchange: [`fmi2_shell`]'s, around
 //!   [`instance::Instance`];
 //! - [`contract`]: value references and the model description, generated from

@@ -220,7 +220,7 @@ impl<S: Slave> Fmu<S> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::contract::{Causality, Kind, Start, Variable, unknown};
+    use crate::contract::{Causality, Kind, Range, Start, Variable, unknown};
     use crate::slave::Identity;
 
     const fn var(name: &'static str, vr: u32, causality: Causality) -> Variable {
@@ -233,6 +233,7 @@ mod tests {
             unit: "",
             depends_on: &[],
             derivative: false,
+            range: Range::ANY,
             description: "",
         }
     }

@@ -1,8 +1,8 @@
-//! The slave of the shell ([`fmi2_shell::Slave`]): the gear pair's variables, stepping and
-//! Model Exchange equations as methods on a typed instance, free of C types. Each method
-//! returns `Ok(())` or an [`FmiError`] with its reason; the shell applies FMI's rules (state
-//! machine, time checks, what may be set when) before calling in and turns the results into
-//! fmi2Status and log lines.
+//! The slave of the shell ([`fmi2_shell::Slave`]) for either interface: the gear pair's
+//! variables, co-simulation stepping and Model Exchange equations as typed methods, free of C
+//! types. Each method returns `Ok(())` or an [`FmiError`] with its reason; the shell applies
+//! FMI's rules (state machine, time checks, what may be set when) before calling in and turns
+//! the results into fmi2Status and log lines.
 
 pub mod model_exchange;
 pub mod simulation;
@@ -24,8 +24,8 @@ const STEPS: usize = contract::log::logStep;
 const _: () = assert!(contract::log::logStatusError == fmi2_shell::log::ERRORS);
 const _: () = assert!(contract::log::logStatusWarning == fmi2_shell::log::WARNINGS);
 
-/// One instance's model. Everything but the logging settings and the queued lines is part
-/// of its FMU state (fmi2GetFMUstate / fmi2SerializeFMUstate): parameters, inputs, the
+/// The model of one FMU instance. Everything but the logging settings and the queued lines is
+/// part of its FMU state (fmi2GetFMUstate / fmi2SerializeFMUstate): parameters, inputs, the
 /// model's state and time, the integrator's step size and controller memory, counters,
 /// energies.
 #[derive(Clone, Debug, Serialize, Deserialize)]

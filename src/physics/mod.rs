@@ -15,5 +15,5 @@ pub use contact::{ContactLaw, ForceSlopes, Region};
 pub use excitation::{Excitation, Polynomial, Shaft, Sine, TorqueRamp};
 pub use flight::{Flight, FlightStart, FlightState};
 pub use motion::{Dynamics, Loads, MainShaft};
-pub use params::{GearParams, ParamError};
+pub use params::GearParams;
 pub use series::ContactSeries;
