@@ -29,8 +29,8 @@ fmu: $(FMU)
 
 # The fragments build the binaries and name them in PACKAGE_FLAGS: mk/portable.mk linux64
 # (for glibc 2.17) and darwin64 with zig, mk/windows.mk win64.
-$(FMU): $(FMU_DEPS) src/bin/package.rs | libclang
-	cargo run --release --quiet --bin package -- $(PACKAGE_FLAGS) --out $(FMU)
+$(FMU): $(FMU_DEPS) $(wildcard packaging/src/*.rs packaging/src/bin/*.rs) | libclang
+	cargo run --release --quiet -p packaging --bin package -- --model GearRattle $(PACKAGE_FLAGS) --out $(FMU)
 
 # The native library, loaded by the C-API tests (the FMU's linux64 binary is built by
 # mk/portable.mk). cargo decides what to rebuild; this rule always asks it.
@@ -46,9 +46,10 @@ demo: fmu $(VENV)/.installed
 ## test: every test: Rust (cargo test) and the FMU as a user runs it (pytest + fmpy)
 test: $(TEST_TARGETS)
 
-# The C-API tests load the cdylib, which `cargo test` alone does not produce.
+# The C-API tests load the cdylib, which `cargo test` alone does not produce. fmi2-shell's
+# own tests check FMI's rules on a model of their own.
 test-rust: $(LIB) | libclang
-	cargo test --release
+	cargo test --release -p gear_rattle -p fmi2-shell
 
 test-python: fmu $(VENV)/.installed
 	$(PY) -m pytest -q

@@ -18,7 +18,7 @@ flywheel-fmu: $(FLYWHEEL_FMU)
 # cargo decides what to rebuild; the model description is written from src/model.rs.
 $(FLYWHEEL_FMU): FORCE
 	cargo build --release -p flywheel
-	cargo run --release --quiet -p flywheel --bin flywheel-package -- --lib $(FLYWHEEL_LIB) --out $@
+	cargo run --release --quiet -p packaging --bin package -- --model Flywheel --lib $(FLYWHEEL_LIB) --out $@
 
 # The master tests live in pytest's testpaths: `make test-python` runs them, so it needs
 # the partner FMU and the Ecos runtime library too.

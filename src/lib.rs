@@ -9,18 +9,18 @@
 //!   dense outputs, the hand-over between them, and edge location;
 //! - [`rattle`]: the gear pair as a piecewise ODE for the integrator, with impact counting
 //!   (the shaft's motion imposed; [`rattle::torque`]: driven by a torque, 7 states);
-//! - [`instance`]: one FMU instance (variables, co-simulation stepping, Model Exchange's
-//!   states and events);
+//! - [`instance`]: the slave of fmi2-shell (variables, co-simulation stepping, Model
+//!   Exchange's states and events; the shell applies FMI's rules around it);
 //! - the `fmi2*` C exports of Co-Simulation and Model Exchange: [`fmi2_shell`]'s, around
 //!   [`instance::Instance`];
 //! - [`contract`]: value references and the model description, generated from
-//!   `modelDescription/GearRattle.toml`.
+//!   `modelDescription/GearRattle.toml` (packaged into the .fmu by the workspace's
+//!   `packaging` crate).
 
 pub mod contract;
 pub mod instance;
 pub mod integrator;
 pub mod math;
-pub mod packaging;
 pub mod physics;
 pub mod rattle;
 

@@ -5,7 +5,7 @@
 use fmi::fmi2::import::Fmi2Import;
 use fmi::fmi2::instance::{CoSimulation, Common};
 use gear_rattle::contract::vr;
-use gear_rattle::packaging::{Binary, write_fmu};
+use packaging::{Binary, models, write_fmu};
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
@@ -34,6 +34,7 @@ fn fmu() -> &'static Path {
         let fmu = dir.join("GearRattle.fmu");
         write_fmu(
             &fmu,
+            &models::gear_rattle(),
             &[Binary {
                 platform: "linux64",
                 extension: "so",

@@ -1,7 +1,8 @@
 //! What an fmi2Component points to, and the guard every C export goes through: it checks the
-//! state machine, runs the call inside `catch_unwind` (no panic crosses the C boundary), and
+//! state table, runs the call inside `catch_unwind` (no panic crosses the C boundary), and
 //! hands the call's log lines to the importer's logger.
 
+use crate::fmu::Fmu;
 use crate::logger::{Logger, fmi2_status};
 use crate::slave::Slave;
 use crate::state::FmiState;
@@ -9,16 +10,16 @@ use crate::status::{FmiError, FmiResult, Status};
 use fmi_sys::fmi2::{fmi2Component, fmi2Status, fmi2Status_fmi2Error};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
-/// A slave and the logger of the importer that instantiated it.
+/// An FMU instance and the logger of the importer that instantiated it.
 pub struct Component<S> {
-    pub slave: S,
+    pub fmu: Fmu<S>,
     pub logger: Logger,
 }
 
 impl<S: Slave> Component<S> {
     /// Hands the queued log lines to the importer's logger.
     pub fn flush_log(&mut self) {
-        for m in self.slave.log().messages.drain(..) {
+        for m in self.fmu.log().messages.drain(..) {
             self.logger.log(m.status, m.category, &m.text);
         }
     }
@@ -33,15 +34,15 @@ pub fn panic_text(payload: &(dyn std::any::Any + Send)) -> String {
         .unwrap_or_else(|| "unknown panic".to_string())
 }
 
-/// Runs `call` on the slave behind `c` if `allowed` admits its state; a refused call or an
-/// error is logged with the function's name, a panic puts the slave into the error state.
+/// Runs `call` on the instance behind `c` if `allowed` admits its state; a refused call or an
+/// error is logged with the function's name, a panic puts the instance into the error state.
 /// The path of an accepted call that logs nothing is kept short: it is taken at every step.
 #[inline]
 pub fn guard<S: Slave>(
     c: fmi2Component,
     function: &str,
     allowed: u8,
-    call: impl FnOnce(&mut S) -> FmiResult,
+    call: impl FnOnce(&mut Fmu<S>) -> FmiResult,
 ) -> fmi2Status {
     if c.is_null() {
         return fmi2Status_fmi2Error;
@@ -49,11 +50,11 @@ pub fn guard<S: Slave>(
     // SAFETY: a non-null fmi2Component is one fmi2Instantiate returned for this slave type,
     // not yet freed, and FMI forbids concurrent calls on one instance.
     let component = unsafe { &mut *(c as *mut Component<S>) };
-    if !component.slave.state().allows(allowed) {
+    if !component.fmu.state.allows(allowed) {
         return refuse(component, function);
     }
-    let outcome = catch_unwind(AssertUnwindSafe(|| call(&mut component.slave)));
-    if matches!(outcome, Ok(Ok(()))) && component.slave.log().messages.is_empty() {
+    let outcome = catch_unwind(AssertUnwindSafe(|| call(&mut component.fmu)));
+    if matches!(outcome, Ok(Ok(()))) && component.fmu.log().messages.is_empty() {
         return fmi2_status(Status::Ok);
     }
     report(component, function, outcome)
@@ -64,7 +65,7 @@ pub fn guard<S: Slave>(
 fn refuse<S: Slave>(component: &mut Component<S>, function: &str) -> fmi2Status {
     let e = FmiError::error(format!(
         "illegal call sequence: {function} is not allowed in state {:?}",
-        component.slave.state()
+        component.fmu.state
     ));
     report(component, function, Ok(Err(e)))
 }
@@ -76,7 +77,7 @@ fn report<S: Slave>(
     function: &str,
     outcome: std::thread::Result<FmiResult>,
 ) -> fmi2Status {
-    let slave = &mut component.slave;
+    let fmu = &mut component.fmu;
     let status = match outcome {
         Ok(Ok(())) => Status::Ok,
         Ok(Err(e)) => {
@@ -84,16 +85,16 @@ fn report<S: Slave>(
                 message: format!("{function}: {}", e.message),
                 ..e
             };
-            slave.log().error(&e);
+            fmu.log().error(&e);
             e.status
         }
         Err(payload) => {
-            slave.set_state(FmiState::Error);
+            fmu.state = FmiState::Error;
             let e = FmiError::error(format!(
                 "{function}: internal error ({}); the instance is in the error state, fmi2Reset to start over",
                 panic_text(payload.as_ref())
             ));
-            slave.log().error(&e);
+            fmu.log().error(&e);
             e.status
         }
     };

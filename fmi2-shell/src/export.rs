@@ -5,6 +5,7 @@
 #![allow(clippy::missing_safety_doc)]
 
 use crate::component::{Component, slice, slice_mut};
+use crate::fmu::Fmu;
 use crate::logger::Logger;
 use crate::slave::{EventInfo, Interface, Slave};
 use crate::status::{FmiError, FmiResult, Status};
@@ -89,7 +90,7 @@ pub unsafe fn instantiate<S: Slave>(
             }
         };
         let component = Box::new(Component {
-            slave: S::new(logging_on != 0, interface),
+            fmu: Fmu::<S>::new(logging_on != 0, interface),
             logger,
         });
         Box::into_raw(component) as fmi2Component

@@ -1,20 +1,21 @@
 //! FMU states: the boxed copies fmi2GetFMUstate hands out (tagged with the model's GUID, so
 //! that a pointer from another model or none of ours is refused, not read), and their
 //! serialized form: a header (the model's magic, the format's version, the length), the
-//! postcard bytes of the GUID and the slave, and a CRC-32 of those bytes.
+//! postcard bytes of the GUID and the instance ([`Fmu`]), and a CRC-32 of those bytes.
 
-use crate::slave::{Slave, snapshot};
+use crate::fmu::Fmu;
+use crate::slave::Slave;
 use crate::status::{FmiError, FmiResult};
 use fmi_sys::fmi2::fmi2FMUstate;
 use serde::{Deserialize, Serialize};
 
 /// What an fmi2FMUstate points to. `repr(C)`: the tag first, so that telling a foreign
 /// pointer reads only its first eight bytes (Rust's own layout may put the tag after the
-/// slave, thousands of bytes further).
+/// instance, thousands of bytes further).
 #[repr(C)]
 pub struct FmuState<S> {
     tag: u64,
-    pub slave: S,
+    pub fmu: Fmu<S>,
 }
 
 /// FNV-1a of the model's GUID: the tag of its FMU states.
@@ -27,12 +28,12 @@ fn tag<S: Slave>() -> u64 {
         })
 }
 
-/// Stores a copy of `slave` into the importer's slot: a new state if it holds NULL, else the
+/// Stores a copy of `fmu` into the importer's slot: a new state if it holds NULL, else the
 /// state it holds (one of ours) is overwritten.
 ///
 /// # Safety
 /// `state` is NULL or points to the importer's slot, holding NULL or a state of this model.
-pub unsafe fn store<S: Slave>(state: *mut fmi2FMUstate, slave: S) -> FmiResult {
+pub unsafe fn store<S: Slave>(state: *mut fmi2FMUstate, fmu: Fmu<S>) -> FmiResult {
     if state.is_null() {
         return Err(FmiError::error("the FMUstate argument is NULL"));
     }
@@ -41,12 +42,12 @@ pub unsafe fn store<S: Slave>(state: *mut fmi2FMUstate, slave: S) -> FmiResult {
     if slot.is_null() {
         *slot = Box::into_raw(Box::new(FmuState {
             tag: tag::<S>(),
-            slave,
+            fmu,
         })) as fmi2FMUstate;
     } else {
         // SAFETY: checked to be one of ours just before it is written.
         unsafe { get::<S>(*slot) }?;
-        unsafe { (*(*slot as *mut FmuState<S>)).slave = slave };
+        unsafe { (*(*slot as *mut FmuState<S>)).fmu = fmu };
     }
     Ok(())
 }
@@ -92,17 +93,17 @@ const TRAILER: usize = 4;
 #[derive(Serialize, Deserialize)]
 struct Payload<S> {
     guid: String,
-    slave: S,
+    fmu: Fmu<S>,
 }
 
 /// The bytes of fmi2SerializeFMUstate.
-pub fn serialize<S: Slave>(slave: &S) -> Vec<u8> {
+pub fn serialize<S: Slave>(fmu: &Fmu<S>) -> Vec<u8> {
     let id = &S::IDENTITY;
     let payload = postcard::to_allocvec(&Payload {
         guid: id.guid.to_string(),
-        slave: snapshot(slave),
+        fmu: fmu.snapshot(),
     })
-    .expect("a slave always encodes");
+    .expect("an instance always encodes");
     let mut bytes = Vec::with_capacity(HEADER + payload.len() + TRAILER);
     bytes.extend_from_slice(&id.state_magic);
     bytes.extend_from_slice(&id.state_version.to_le_bytes());
@@ -116,9 +117,9 @@ fn refuse(why: &str) -> FmiError {
     FmiError::error(format!("serialized FMU state refused: {why}"))
 }
 
-/// fmi2DeSerializeFMUstate: the slave saved in `bytes`, checked for its magic, version,
-/// length, checksum and GUID before it is decoded.
-pub fn deserialize<S: Slave>(bytes: &[u8]) -> FmiResult<S> {
+/// fmi2DeSerializeFMUstate: the instance saved in `bytes`, checked for its magic, version,
+/// length, checksum and GUID before it is decoded, and as [`Fmu::check_decoded`] after.
+pub fn deserialize<S: Slave>(bytes: &[u8]) -> FmiResult<Fmu<S>> {
     let id = &S::IDENTITY;
     if bytes.len() < HEADER + TRAILER || bytes[..4] != id.state_magic {
         return Err(refuse(&format!(
@@ -155,10 +156,10 @@ pub fn deserialize<S: Slave>(bytes: &[u8]) -> FmiResult<S> {
         )));
     }
     decoded
-        .slave
+        .fmu
         .check_decoded()
         .map_err(|e| refuse(&e.message))?;
-    Ok(decoded.slave)
+    Ok(decoded.fmu)
 }
 
 #[cfg(test)]

@@ -1,15 +1,18 @@
 //! fmi2-shell: the FMI 2.0 layer of GearRattle and its partner FMUs, written once.
 //!
-//! A model is a [`Slave`]: a typed Rust value with methods for the FMI calls, free of C
-//! types. The shell gives it
+//! A model is a [`Slave`]: a typed Rust value with its variables, equations and stepping,
+//! free of C types and of FMI's rules. The shell gives it
 //! - the C exports ([`export_co_simulation!`]), each a guard ([`component`]) that checks the
-//!   state machine ([`state`]), unpacks the C arguments, catches panics, and hands log
+//!   state table ([`state`]), unpacks the C arguments, catches panics, and hands log
 //!   lines ([`log`]) to the importer's logger ([`logger`]);
+//! - FMI's rules around the slave ([`fmu`]): the state transitions, the instance's time and
+//!   last successful time, the checks of the time arguments ([`time`]) and of fmi2Set*
+//!   against the contract;
 //! - FMU states ([`fmu_state`]): boxed copies, and their serialized form with the model's
 //!   magic, version, GUID and a CRC;
 //! - statuses and errors in FMI's terms ([`status`]), and the store of the values set
 //!   ([`values`]);
-//! - the types of the contract and the checks of fmi2Set* against it ([`contract`]) and, for
+//! - the types of the contract and the checks of a variable's setting ([`contract`]) and, for
 //!   build scripts, the generator of the model description and of the constants from the
 //!   contract TOML (`build`, feature "build"), and the variable tables of the documentation
 //!   ([`table`]).
@@ -21,6 +24,7 @@ pub mod component;
 pub mod contract;
 #[cfg(feature = "runtime")]
 pub mod export;
+pub mod fmu;
 #[cfg(feature = "runtime")]
 pub mod fmu_state;
 pub mod log;
@@ -32,10 +36,12 @@ pub mod slave;
 pub mod state;
 pub mod status;
 pub mod table;
+pub mod time;
 pub mod values;
 
 #[cfg(feature = "runtime")]
 pub use fmi_sys::fmi2;
+pub use fmu::Fmu;
 pub use log::{Log, Message};
 pub use slave::{EventInfo, Identity, Interface, Slave};
 pub use state::FmiState;

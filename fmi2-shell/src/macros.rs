@@ -3,10 +3,12 @@
 //! model's cdylib (a generic function cannot be exported, and the symbols must live in the
 //! library the importer loads). Each function is written once, as in the Reference-FMUs'
 //! `fmi2Functions.c`: its C arguments, the states it may be called in ([`allowed`]), and what
-//! it does with the slave, run through the [`guard`].
+//! it does with the instance ([`Fmu`]: FMI's rules, then the model's slave), run through the
+//! [`guard`].
 //!
 //! [`allowed`]: crate::state::allowed
 //! [`guard`]: crate::component::guard
+//! [`Fmu`]: crate::fmu::Fmu
 
 /// `array!(p, n)`: the importer's array `p` of `n` elements as a slice (`array!(mut p, n)`: a
 /// mutable one), or the call's error naming `p` if it is NULL (see
@@ -23,9 +25,9 @@ macro_rules! array {
 }
 
 /// Defines the module `$module` of exports for the slave type `$slave`: the `items` as they
-/// are, then each `fn fmi2Name(args after the component) ALLOWED |slave| body;` as
-/// `fmi2Name(fmi2Component c, args)`, which runs `body` through the guard under the name
-/// "fmi2Name" with the mask `allowed::ALLOWED`. Pointer arguments are the importer's, each
+/// are, then each `fn fmi2Name(args after the component) ALLOWED |fmu| body;` as
+/// `fmi2Name(fmi2Component c, args)`, which runs `body` on the instance (`Fmu<$slave>`)
+/// through the guard under the name "fmi2Name" with the mask `allowed::ALLOWED`. Pointer arguments are the importer's, each
 /// valid for the length the call gives (FMI's contract); the bodies turn them into slices
 /// with [`array!`](crate::array), which refuses a NULL one.
 #[doc(hidden)]
@@ -41,6 +43,7 @@ macro_rules! exports {
             use $crate::contract::no_variables;
             use $crate::export as e;
             use $crate::fmi2::*;
+            use $crate::fmu::Fmu;
             use $crate::slave::Slave as _;
             use $crate::status::FmiError;
             type S = $slave;
@@ -49,7 +52,7 @@ macro_rules! exports {
             $(
                 #[unsafe(no_mangle)]
                 pub unsafe extern "C" fn $name(c: fmi2Component, $($arg: $ty),*) -> fmi2Status {
-                    $crate::component::guard(c, stringify!($name), $crate::state::allowed::$allowed, |$s: &mut S| $body)
+                    $crate::component::guard(c, stringify!($name), $crate::state::allowed::$allowed, |$s: &mut Fmu<S>| $body)
                 }
             )*
         }
@@ -65,7 +68,6 @@ macro_rules! export_co_simulation {
             use ::std::ffi::c_char;
             use $crate::component::{slice, slice_mut};
             use $crate::fmu_state;
-            use $crate::slave::{reset, restore, snapshot};
 
             #[unsafe(no_mangle)]
             pub extern "C" fn fmi2GetTypesPlatform() -> *const c_char {
@@ -100,24 +102,16 @@ macro_rules! export_co_simulation {
                 };
             fn fmi2SetupExperiment(toleranceDefined: fmi2Boolean, tolerance: fmi2Real, startTime: fmi2Real,
                 _stopTimeDefined: fmi2Boolean, _stopTime: fmi2Real)
-                SETUP_EXPERIMENT |s| {
-                    if !startTime.is_finite() {
-                        return Err(FmiError::error(format!("startTime = {startTime} must be finite")));
-                    }
-                    s.setup_experiment((toleranceDefined != 0).then_some(tolerance), startTime)
-                };
+                SETUP_EXPERIMENT |s| s.setup_experiment((toleranceDefined != 0).then_some(tolerance), startTime);
             fn fmi2EnterInitializationMode() ENTER_INITIALIZATION_MODE |s| s.enter_initialization_mode();
             fn fmi2ExitInitializationMode() EXIT_INITIALIZATION_MODE |s| s.exit_initialization_mode();
             fn fmi2Terminate() TERMINATE |s| s.terminate();
-            fn fmi2Reset() RESET |s| {
-                reset(s);
-                Ok(())
-            };
+            fn fmi2Reset() RESET |s| s.reset();
 
             fn fmi2GetReal(vr: *const fmi2ValueReference, nvr: usize, value: *mut fmi2Real)
-                GET |s| s.get_real(array!(vr, nvr), array!(mut value, nvr));
+                GET |s| s.slave.get_real(array!(vr, nvr), array!(mut value, nvr));
             fn fmi2GetInteger(vr: *const fmi2ValueReference, nvr: usize, value: *mut fmi2Integer)
-                GET |s| s.get_integer(array!(vr, nvr), array!(mut value, nvr));
+                GET |s| s.slave.get_integer(array!(vr, nvr), array!(mut value, nvr));
             fn fmi2GetBoolean(vr: *const fmi2ValueReference, nvr: usize, _value: *mut fmi2Boolean)
                 GET |_| no_variables("Boolean", array!(vr, nvr));
             fn fmi2GetString(vr: *const fmi2ValueReference, nvr: usize, _value: *mut fmi2String)
@@ -149,29 +143,18 @@ macro_rules! export_co_simulation {
                 GET_STATUS |_| e::unavailable(kind);
 
             fn fmi2GetFMUstate(state: *mut fmi2FMUstate)
-                FMU_STATE |s| unsafe { fmu_state::store(state, snapshot(s)) };
-            fn fmi2SetFMUstate(state: fmi2FMUstate) FMU_STATE |s| {
-                let saved = unsafe { fmu_state::get::<S>(state) }?;
-                // A state holds its instance's interface, which the importer's calls must keep.
-                if saved.slave.interface() != s.interface() {
-                    return Err(FmiError::error(format!(
-                        "the FMU state is of a {:?} instance, this one is {:?}",
-                        saved.slave.interface(),
-                        s.interface()
-                    )));
-                }
-                restore(s, &saved.slave);
-                Ok(())
-            };
+                FMU_STATE |s| unsafe { fmu_state::store(state, s.snapshot()) };
+            fn fmi2SetFMUstate(state: fmi2FMUstate)
+                FMU_STATE |s| s.restore(&unsafe { fmu_state::get::<S>(state) }?.fmu);
             fn fmi2FreeFMUstate(state: *mut fmi2FMUstate)
                 FMU_STATE |_| unsafe { fmu_state::free::<S>(state) };
             fn fmi2SerializedFMUstateSize(state: fmi2FMUstate, size: *mut usize) FMU_STATE |_| {
                 let saved = unsafe { fmu_state::get::<S>(state) }?;
-                array!(mut size, 1)[0] = fmu_state::serialize(&saved.slave).len();
+                array!(mut size, 1)[0] = fmu_state::serialize(&saved.fmu).len();
                 Ok(())
             };
             fn fmi2SerializeFMUstate(state: fmi2FMUstate, bytes: *mut fmi2Byte, size: usize) FMU_STATE |_| {
-                let data = fmu_state::serialize(&unsafe { fmu_state::get::<S>(state) }?.slave);
+                let data = fmu_state::serialize(&unsafe { fmu_state::get::<S>(state) }?.fmu);
                 if data.len() != size {
                     return Err(FmiError::error(format!(
                         "size {size} given, the serialized state has {} bytes (fmi2SerializedFMUstateSize)",
@@ -184,21 +167,21 @@ macro_rules! export_co_simulation {
             fn fmi2DeSerializeFMUstate(bytes: *const fmi2Byte, size: usize, state: *mut fmi2FMUstate)
                 FMU_STATE |_| {
                     let data = unsafe { slice(bytes as *const u8, size, "serializedState") }?;
-                    let slave = fmu_state::deserialize::<S>(data)?;
-                    unsafe { fmu_state::store(state, slave) }
+                    let fmu = fmu_state::deserialize::<S>(data)?;
+                    unsafe { fmu_state::store(state, fmu) }
                 };
 
             fn fmi2GetDirectionalDerivative(vUnknown_ref: *const fmi2ValueReference, nUnknown: usize,
                 vKnown_ref: *const fmi2ValueReference, nKnown: usize, dvKnown: *const fmi2Real,
                 dvUnknown: *mut fmi2Real)
-                GET |s| s.directional_derivative(array!(vUnknown_ref, nUnknown), array!(vKnown_ref, nKnown),
+                GET |s| s.slave.directional_derivative(array!(vUnknown_ref, nUnknown), array!(vKnown_ref, nKnown),
                     array!(dvKnown, nKnown), array!(mut dvUnknown, nUnknown));
             fn fmi2SetRealInputDerivatives(vr: *const fmi2ValueReference, nvr: usize,
                 order: *const fmi2Integer, value: *const fmi2Real)
                 SET |s| s.set_input_derivatives(array!(vr, nvr), array!(order, nvr), array!(value, nvr));
             fn fmi2GetRealOutputDerivatives(vr: *const fmi2ValueReference, nvr: usize,
                 order: *const fmi2Integer, value: *mut fmi2Real)
-                GET |s| s.get_output_derivatives(array!(vr, nvr), array!(order, nvr), array!(mut value, nvr));
+                GET |s| s.slave.get_output_derivatives(array!(vr, nvr), array!(order, nvr), array!(mut value, nvr));
         }
     };
 }
@@ -211,13 +194,13 @@ macro_rules! export_model_exchange {
         $crate::exports! { mod fmi2_model_exchange_exports for $slave; {}
             fn fmi2SetTime(time: fmi2Real) SET_TIME |s| s.set_time(time);
             fn fmi2SetContinuousStates(x: *const fmi2Real, nx: usize)
-                SET_CONTINUOUS_STATES |s| s.set_continuous_states(array!(x, nx));
+                SET_CONTINUOUS_STATES |s| s.slave.set_continuous_states(array!(x, nx));
             fn fmi2EnterEventMode() ENTER_EVENT_MODE |s| s.enter_event_mode();
             fn fmi2NewDiscreteStates(info: *mut fmi2EventInfo) NEW_DISCRETE_STATES |s| {
                 let Some(out) = (unsafe { info.as_mut() }) else {
                     return Err(FmiError::error("fmi2EventInfo is NULL"));
                 };
-                e::event_info(s.new_discrete_states()?, out);
+                e::event_info(s.slave.new_discrete_states()?, out);
                 Ok(())
             };
             fn fmi2EnterContinuousTimeMode() ENTER_CONTINUOUS_TIME_MODE |s| s.enter_continuous_time_mode();
@@ -235,13 +218,13 @@ macro_rules! export_model_exchange {
                     Ok(())
                 };
             fn fmi2GetDerivatives(derivatives: *mut fmi2Real, nx: usize) GET_CONTINUOUS
-                |s| s.get_derivatives(array!(mut derivatives, nx));
+                |s| s.slave.get_derivatives(array!(mut derivatives, nx));
             fn fmi2GetEventIndicators(eventIndicators: *mut fmi2Real, ni: usize) GET_CONTINUOUS
-                |s| s.get_event_indicators(array!(mut eventIndicators, ni));
+                |s| s.slave.get_event_indicators(array!(mut eventIndicators, ni));
             fn fmi2GetContinuousStates(x: *mut fmi2Real, nx: usize) GET_CONTINUOUS
-                |s| s.get_continuous_states(array!(mut x, nx));
+                |s| s.slave.get_continuous_states(array!(mut x, nx));
             fn fmi2GetNominalsOfContinuousStates(x_nominal: *mut fmi2Real, nx: usize) GET_CONTINUOUS
-                |s| s.get_nominals_of_continuous_states(array!(mut x_nominal, nx));
+                |s| s.slave.get_nominals_of_continuous_states(array!(mut x_nominal, nx));
         }
     };
 }

@@ -1,15 +1,17 @@
-//! What a model gives the shell: an FMU instance as a typed Rust value, free of C types, for
+//! What a model gives the shell: a typed Rust value, free of C types and of FMI's rules, for
 //! Co-Simulation and, where the model offers it, Model Exchange. The shell's C exports check
-//! the state machine, unpack the arguments, call these methods, and turn their results into
-//! statuses and log lines.
+//! the state machine, unpack the arguments, apply FMI's rules ([`crate::fmu`]), call these
+//! methods, and turn their results into statuses and log lines.
 
+use crate::contract::{Kind, Variable, no_variables};
 use crate::log::{Categories, Log};
 use crate::state::FmiState;
 use crate::status::{FmiError, FmiResult};
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 
-/// Who a model is: what fmi2Instantiate checks and what tags its FMU states.
+/// Who a model is: what fmi2Instantiate checks, what tags its FMU states, where its
+/// variables are looked up.
 pub struct Identity {
     /// The GUID of the model description the binary was built with.
     pub guid: &'static str,
@@ -17,11 +19,14 @@ pub struct Identity {
     /// Log categories, errors first, then warnings ([`Log`]).
     pub log_categories: Categories,
     /// First bytes of a serialized FMU state, and its format's version (raised whenever the
-    /// slave's serialized shape changes).
+    /// serialized shape of the instance, the shell's part or the slave's, changes).
     pub state_magic: [u8; 4],
     pub state_version: u16,
     /// Whether the model offers Model Exchange besides Co-Simulation.
     pub model_exchange: bool,
+    /// The contract's variable of a kind and value reference, or the error for an unknown
+    /// one (the generated `contract::variable`): the shell checks fmi2Set* against it.
+    pub variable: fn(Kind, u32) -> FmiResult<&'static Variable>,
 }
 
 /// The interface an instance was instantiated for.
@@ -43,12 +48,17 @@ pub struct EventInfo {
     pub next_event_time: Option<f64>,
 }
 
-/// A co-simulation slave. Everything but its [`Log`] is its FMU state (clone and serde).
+/// What a model supplies to the shell: its variables, its equations and stepping, its own
+/// validation. The FMI rules (the state machine's transitions, the time checks, which
+/// variables may be set in which state, the instance's time and last successful time) are
+/// the shell's ([`Fmu`]), which calls these methods only where those rules admit the call.
+/// Everything but its [`Log`] is part of the FMU state (clone and serde).
+///
+/// [`Fmu`]: crate::fmu::Fmu
 pub trait Slave: Clone + Serialize + DeserializeOwned {
     const IDENTITY: Identity;
 
-    /// A fresh instance for `interface` (state Instantiated, start values), logging as
-    /// `logging_on` says.
+    /// A fresh instance for `interface` (start values), logging as `logging_on` says.
     fn new(logging_on: bool, interface: Interface) -> Self;
 
     /// The interface it was instantiated for.
@@ -58,45 +68,47 @@ pub trait Slave: Clone + Serialize + DeserializeOwned {
 
     fn log(&mut self) -> &mut Log;
 
-    fn state(&self) -> FmiState;
+    /// fmi2SetupExperiment, after the shell's checks (finite start time, tolerance in (0, 1)).
+    fn setup_experiment(&mut self, _tolerance: Option<f64>, _start_time: f64) {}
 
-    /// Sets the state: the shell moves a slave into [`FmiState::Error`] after a panic.
-    fn set_state(&mut self, state: FmiState);
+    /// fmi2EnterInitializationMode, before the shell enters that state.
+    fn enter_initialization_mode(&mut self) {}
 
-    /// fmi2SetupExperiment, with a finite start time (the shell checks it).
-    fn setup_experiment(&mut self, tolerance: Option<f64>, start_time: f64) -> FmiResult;
-
-    fn enter_initialization_mode(&mut self) -> FmiResult {
-        self.set_state(FmiState::InitializationMode);
-        Ok(())
-    }
-
+    /// fmi2ExitInitializationMode: validates the parameters and builds the initial state at
+    /// the start time. On an error the shell keeps the instance in initialisation mode.
     fn exit_initialization_mode(&mut self) -> FmiResult;
 
-    fn terminate(&mut self) -> FmiResult {
-        self.set_state(FmiState::Terminated);
-        Ok(())
-    }
-
     fn get_real(&mut self, vrs: &[u32], out: &mut [f64]) -> FmiResult;
-    fn get_integer(&mut self, vrs: &[u32], out: &mut [i32]) -> FmiResult;
-    fn set_real(&mut self, vrs: &[u32], values: &[f64]) -> FmiResult;
-    fn set_integer(&mut self, vrs: &[u32], values: &[i32]) -> FmiResult;
 
-    fn do_step(&mut self, current: f64, h: f64) -> FmiResult;
+    fn get_integer(&mut self, vrs: &[u32], _out: &mut [i32]) -> FmiResult {
+        no_variables("Integer", vrs)
+    }
 
-    /// Whether a slave decoded by fmi2DeSerializeFMUstate is one this build can run: the
-    /// envelope's checksum catches corrupt bytes, not bytes made by hand with a valid one.
-    fn check_decoded(&self) -> FmiResult {
+    /// fmi2SetReal in `state`, after the shell has checked every value reference against the
+    /// contract (known, settable in `state`, finite): the whole call is admitted.
+    fn set_real(&mut self, state: FmiState, vrs: &[u32], values: &[f64]) -> FmiResult;
+
+    /// fmi2SetInteger in `state`, checked as [`set_real`](Slave::set_real).
+    fn set_integer(&mut self, _state: FmiState, vrs: &[u32], _values: &[i32]) -> FmiResult {
+        no_variables("Integer", vrs)
+    }
+
+    /// One communication step from `t` (the importer's communication point, checked against
+    /// the instance's time) to `t + h` (h finite, > 0 and resolved there). On an error the
+    /// shell moves the instance into [`FmiState::Error`]; on success its time is `t + h`.
+    fn step(&mut self, t: f64, h: f64) -> FmiResult;
+
+    /// Whether a slave decoded by fmi2DeSerializeFMUstate in `state` is one this build can
+    /// run: the envelope's checksum catches corrupt bytes, not bytes made by hand with a
+    /// valid one.
+    fn check_decoded(&self, _state: FmiState) -> FmiResult {
         Ok(())
     }
 
-    /// fmi2LastSuccessfulTime.
-    fn last_successful_time(&self) -> f64;
-
-    /// fmi2SetRealInputDerivatives (canInterpolateInputs).
+    /// fmi2SetRealInputDerivatives (canInterpolateInputs) in `state`.
     fn set_input_derivatives(
         &mut self,
+        _state: FmiState,
         _vrs: &[u32],
         _orders: &[i32],
         _values: &[f64],
@@ -141,8 +153,10 @@ pub trait Slave: Clone + Serialize + DeserializeOwned {
         Err(unsupported("fmi2GetDirectionalDerivative"))
     }
 
-    // Model Exchange (offered where `IDENTITY.model_exchange`).
+    // Model Exchange (offered where `IDENTITY.model_exchange`; the shell's state machine
+    // admits these calls only in an instance of that interface).
 
+    /// fmi2SetTime with a finite time (the shell checks it and keeps it on success).
     fn set_time(&mut self, _t: f64) -> FmiResult {
         Err(unsupported("fmi2SetTime"))
     }
@@ -167,19 +181,13 @@ pub trait Slave: Clone + Serialize + DeserializeOwned {
         Err(unsupported("fmi2GetEventIndicators"))
     }
 
-    fn enter_event_mode(&mut self) -> FmiResult {
-        Err(unsupported("fmi2EnterEventMode"))
-    }
-
+    /// fmi2NewDiscreteStates, in event mode.
     fn new_discrete_states(&mut self) -> FmiResult<EventInfo> {
         Err(unsupported("fmi2NewDiscreteStates"))
     }
 
-    fn enter_continuous_time_mode(&mut self) -> FmiResult {
-        Err(unsupported("fmi2EnterContinuousTimeMode"))
-    }
-
-    /// fmi2CompletedIntegratorStep: whether the importer must enter event mode now.
+    /// fmi2CompletedIntegratorStep: whether the importer must enter event mode now (the
+    /// shell then takes the current time as the last successful one).
     fn completed_integrator_step(&mut self) -> FmiResult<bool> {
         Err(unsupported("fmi2CompletedIntegratorStep"))
     }
@@ -190,24 +198,4 @@ pub fn unsupported(function: &str) -> FmiError {
     FmiError::error(format!(
         "{function} is not supported: the model description does not declare that capability"
     ))
-}
-
-/// A copy of the FMU state: the slave without its queued log lines.
-pub fn snapshot<S: Slave>(slave: &S) -> S {
-    let mut copy = slave.clone();
-    copy.log().messages.clear();
-    copy
-}
-
-/// Takes over a saved FMU state, keeping the slave's logging settings and lines.
-pub fn restore<S: Slave>(slave: &mut S, saved: &S) {
-    let log = std::mem::take(slave.log());
-    *slave = saved.clone();
-    *slave.log() = log;
-}
-
-/// fmi2Reset: back to the state after instantiation, the logging settings kept.
-pub fn reset<S: Slave>(slave: &mut S) {
-    let interface = slave.interface();
-    restore(slave, &S::new(false, interface));
 }

@@ -32,7 +32,7 @@ use capi::{Env, Line, callbacks, ffi, outputs};
 use fmi2_shell::component::Component;
 use fmi2_shell::fmi2::*;
 use fmi2_shell::fmu_state::serialize;
-use fmi2_shell::{FmiState, Interface, Slave as _};
+use fmi2_shell::{FmiState, Interface};
 use gear_rattle::contract::{GUID, Kind, LOG_CATEGORIES, VARIABLES};
 use gear_rattle::instance::Instance;
 use gear_rattle::instance::model_exchange::{NX, NZ};
@@ -486,7 +486,7 @@ impl Harness {
     }
 
     fn fmu_state_bytes(&self) -> Option<Vec<u8>> {
-        self.component().map(|c| serialize(&c.slave))
+        self.component().map(|c| serialize(&c.fmu))
     }
 
     /// The log lines since the last check: printf-safe, of this instance.
@@ -530,7 +530,7 @@ impl Harness {
 
     fn time(&self) -> f64 {
         self.component()
-            .map_or(0.0, |c| c.slave.last_successful_time())
+            .map_or(0.0, |c| c.fmu.last_successful_time())
     }
 
     fn read_outputs(&self, after: &str) {
@@ -681,7 +681,7 @@ impl Harness {
         let c = self.c;
         if self
             .component()
-            .is_some_and(|c| c.slave.state() == FmiState::EventMode)
+            .is_some_and(|c| c.fmu.state == FmiState::EventMode)
             && !self.event_iteration()
         {
             return false;
@@ -1130,7 +1130,7 @@ impl Harness {
         if !status_ok(s)
             && self
                 .component()
-                .is_some_and(|c| c.slave.state() != FmiState::Error)
+                .is_some_and(|c| c.fmu.state != FmiState::Error)
         {
             assert!(
                 self.fmu_state_bytes() == before,
@@ -1144,7 +1144,7 @@ impl Harness {
     fn check_interface(&self) {
         if let Some(c) = self.component() {
             assert_eq!(
-                c.slave.interface(),
+                c.fmu.interface(),
                 self.interface,
                 "the instance changed its interface"
             );
@@ -1328,7 +1328,7 @@ fuzz_target!(|input: Input| {
         if trace {
             let now = h
                 .component()
-                .map(|c| (c.slave.state(), c.slave.last_successful_time()));
+                .map(|c| (c.fmu.state, c.fmu.last_successful_time()));
             eprintln!(
                 "{op:?}\n  -> {now:?}, log {:?}",
                 h.env.lines.lock().unwrap()[h.seen..].to_vec()

@@ -1,7 +1,8 @@
-//! An FMU instance of either interface: FMI 2.0's calls as typed methods, free of C types,
-//! for the shell ([`fmi2_shell::Slave`]). Each method returns `Ok(())` or an [`FmiError`]
-//! with its reason; the shell checks the state machine before calling in and turns the
-//! results into fmi2Status and log lines.
+//! The slave of the shell ([`fmi2_shell::Slave`]) for either interface: the gear pair's
+//! variables, co-simulation stepping and Model Exchange equations as typed methods, free of C
+//! types. Each method returns `Ok(())` or an [`FmiError`] with its reason; the shell applies
+//! FMI's rules (state machine, time checks, what may be set when) before calling in and turns
+//! the results into fmi2Status and log lines.
 
 pub mod model_exchange;
 pub mod simulation;
@@ -23,12 +24,12 @@ const STEPS: usize = contract::log::logStep;
 const _: () = assert!(contract::log::logStatusError == fmi2_shell::log::ERRORS);
 const _: () = assert!(contract::log::logStatusWarning == fmi2_shell::log::WARNINGS);
 
-/// One FMU instance. Everything but the logging settings and the queued lines is
-/// its FMU state (fmi2GetFMUstate / fmi2SerializeFMUstate): parameters, inputs, time, the
-/// model's state, the integrator's step size and controller memory, counters, energies.
+/// The model of one FMU instance. Everything but the logging settings and the queued lines is
+/// part of its FMU state (fmi2GetFMUstate / fmi2SerializeFMUstate): parameters, inputs, the
+/// model's state and time, the integrator's step size and controller memory, counters,
+/// energies.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Instance {
-    pub state: FmiState,
     /// Co-Simulation, or Model Exchange (the importer integrates; see `model_exchange`).
     interface: Interface,
     values: Values,
@@ -40,21 +41,9 @@ pub struct Instance {
     /// The running model; built at fmi2ExitInitializationMode (and for reads during
     /// initialisation, from the values set so far).
     sim: Option<Simulation>,
-    last_successful_time: f64,
     /// Log categories switched on and lines waiting for the importer's logger.
     #[serde(skip)]
     log: Log,
-}
-
-/// Why fmi2DoStep refuses a step ([`Instance::check_step`]).
-#[derive(Clone, Copy, Debug)]
-enum StepRefusal {
-    /// h not finite and > 0.
-    Size,
-    /// The communication point is not the instance's time.
-    Time,
-    /// t + h − t misses h by more than 0.1 % (the value it has).
-    Resolution(f64),
 }
 
 /// Copies a vector of the model into the importer's array, refused if the lengths differ.
@@ -127,11 +116,11 @@ impl Instance {
         })
     }
 
-    /// After new values: rebuild the initial state during initialisation, or hand the main
-    /// shaft's new motion (inputs mode) or torque (torque mode) to the running simulation
-    /// (inputs take effect at once).
-    fn inputs_changed(&mut self) {
-        match self.state {
+    /// After new values in `state`: rebuild the initial state during initialisation, or hand
+    /// the main shaft's new motion (inputs mode) or torque (torque mode) to the running
+    /// simulation (inputs take effect at once).
+    fn inputs_changed(&mut self, state: FmiState) {
+        match state {
             FmiState::EventMode | FmiState::ContinuousTimeMode => {
                 let (shaft, tau, rate) = self.shaft_inputs();
                 let sim = self.sim.as_mut().expect("initialised");
@@ -194,42 +183,6 @@ impl Instance {
             Some(simulation::Drive::Torque { tau, .. }) => self.values.set_real(vr::tau_in, tau),
             _ => {}
         }
-    }
-
-    /// A finite step h > 0 from the instance's time t (to 1e-9 relative), that the time axis
-    /// can represent there to 0.1 %: late in a long run a small step may not exist (at
-    /// t = 1e9 s the spacing of doubles is 1.2e-7 s), and is refused rather than stretched or
-    /// shrunk.
-    #[inline]
-    fn check_step(current: f64, h: f64, t: f64) -> Result<(), StepRefusal> {
-        if !(h > 0.0 && h.is_finite()) {
-            return Err(StepRefusal::Size);
-        }
-        if !current.is_finite() || (current - t).abs() > 1e-9 * t.abs().max(h).max(1e-3) {
-            return Err(StepRefusal::Time);
-        }
-        let resolved = (current + h) - current;
-        if (resolved - h).abs() > 1e-3 * h {
-            return Err(StepRefusal::Resolution(resolved));
-        }
-        Ok(())
-    }
-
-    /// The message of a refused step (kept off the path of a valid one).
-    #[cold]
-    #[inline(never)]
-    fn step_refused(why: StepRefusal, current: f64, h: f64, t: f64) -> FmiError {
-        FmiError::error(match why {
-            StepRefusal::Size => format!(
-                "communicationStepSize = {h:e} at t = {current} refused: it must be finite and > 0"
-            ),
-            StepRefusal::Time => format!(
-                "currentCommunicationPoint = {current} does not match the instance's time {t}"
-            ),
-            StepRefusal::Resolution(resolved) => format!(
-                "communicationStepSize = {h:e} at t = {current} is below the resolution of time there (t + h - t = {resolved:e} s): refused"
-            ),
-        })
     }
 
     fn simulation(&self) -> &Simulation {
@@ -332,8 +285,9 @@ impl Slave for Instance {
         model_identifier: contract::MODEL_IDENTIFIER,
         log_categories: LOG_CATEGORIES,
         state_magic: *b"GRFS",
-        state_version: 6,
+        state_version: 7,
         model_exchange: true,
+        variable: contract::variable,
     };
 
     fn interface(&self) -> Interface {
@@ -344,11 +298,7 @@ impl Slave for Instance {
         &mut self.log
     }
 
-    fn state(&self) -> FmiState {
-        self.state
-    }
-
-    fn check_decoded(&self) -> FmiResult {
+    fn check_decoded(&self, state: FmiState) -> FmiResult {
         self.values.check(contract::VARIABLES)?;
         if !self.tau_in_rate.is_finite() {
             return Err(FmiError::error(format!(
@@ -356,73 +306,42 @@ impl Slave for Instance {
                 self.tau_in_rate
             )));
         }
-        // The running states and the interface each belongs to.
-        let running = match self.state {
-            FmiState::StepComplete => Some(Interface::CoSimulation),
-            FmiState::EventMode | FmiState::ContinuousTimeMode => Some(Interface::ModelExchange),
-            _ => None,
-        };
-        if let Some(interface) = running {
-            if self.sim.is_none() {
-                return Err(FmiError::error("initialised, but without a simulation"));
-            }
-            if interface != self.interface {
-                return Err(FmiError::error(format!(
-                    "a {:?} instance in state {:?}",
-                    self.interface, self.state
-                )));
-            }
+        // The running states step or integrate the simulation.
+        let running = matches!(
+            state,
+            FmiState::StepComplete | FmiState::EventMode | FmiState::ContinuousTimeMode
+        );
+        if running && self.sim.is_none() {
+            return Err(FmiError::error("initialised, but without a simulation"));
         }
         Ok(())
     }
 
-    fn set_state(&mut self, state: FmiState) {
-        self.state = state;
-    }
-
     fn new(logging_on: bool, interface: Interface) -> Self {
         Instance {
-            state: FmiState::Instantiated,
             interface,
             values: Values::start(contract::VARIABLES),
             tau_in_rate: 0.0,
             start_time: 0.0,
             tolerance: None,
             sim: None,
-            last_successful_time: 0.0,
             log: Log::new(LOG_CATEGORIES, logging_on),
         }
     }
 
-    fn setup_experiment(&mut self, tolerance: Option<f64>, start_time: f64) -> FmiResult {
-        if let Some(tol) = tolerance
-            && !(tol > 0.0 && tol < 1.0)
-        {
-            return Err(FmiError::error(format!(
-                "tolerance = {tol:e} must lie in (0, 1)"
-            )));
-        }
+    fn setup_experiment(&mut self, tolerance: Option<f64>, start_time: f64) {
         self.start_time = start_time;
         self.tolerance = tolerance;
-        Ok(())
     }
 
-    fn enter_initialization_mode(&mut self) -> FmiResult {
-        self.state = FmiState::InitializationMode;
+    fn enter_initialization_mode(&mut self) {
         self.sim = None;
-        Ok(())
     }
 
     /// Validates every parameter and builds the initial state; an invalid parameter is
     /// refused and the instance stays in initialisation mode, where it can be corrected.
     fn exit_initialization_mode(&mut self) -> FmiResult {
-        let sim = self.build()?;
-        self.sim = Some(sim);
-        self.last_successful_time = self.start_time;
-        self.state = match self.interface {
-            Interface::CoSimulation => FmiState::StepComplete,
-            Interface::ModelExchange => FmiState::EventMode,
-        };
+        self.sim = Some(self.build()?);
         Ok(())
     }
 
@@ -459,41 +378,33 @@ impl Slave for Instance {
         Ok(())
     }
 
-    /// Sets Real parameters or inputs. The whole call is checked first, so a refused call
-    /// changes nothing.
-    fn set_real(&mut self, vrs: &[u32], values: &[f64]) -> FmiResult {
-        for (vr, value) in vrs.iter().zip(values) {
-            contract::variable(Kind::Real, *vr)?.settable_to(self.state, *value)?;
-        }
+    /// Sets Real parameters or inputs (the shell has checked the whole call).
+    fn set_real(&mut self, state: FmiState, vrs: &[u32], values: &[f64]) -> FmiResult {
         let mut shaft_changed = false;
         for (vr, value) in vrs.iter().zip(values) {
             self.values.set_real(*vr, *value);
             shaft_changed |= matches!(*vr, vr::theta_M | vr::omega_M | vr::alpha_M | vr::tau_in);
         }
-        if shaft_changed || !self.state.is_initialised() {
-            self.inputs_changed();
+        if shaft_changed || !state.is_initialised() {
+            self.inputs_changed(state);
         }
         Ok(())
     }
 
-    fn set_integer(&mut self, vrs: &[u32], values: &[i32]) -> FmiResult {
-        for vr in vrs {
-            contract::variable(Kind::Integer, *vr)?.settable(self.state)?;
-        }
+    fn set_integer(&mut self, state: FmiState, vrs: &[u32], values: &[i32]) -> FmiResult {
         for (vr, value) in vrs.iter().zip(values) {
             self.values.set_integer(*vr, *value as i64);
         }
-        if self.state == FmiState::InitializationMode {
+        if state == FmiState::InitializationMode {
             self.sim = None;
         }
         Ok(())
     }
 
-    fn do_step(&mut self, current: f64, h: f64) -> FmiResult {
+    /// One communication step from the master's point `current` (the shell has checked it
+    /// against the time); a failure leaves the state at `current`.
+    fn step(&mut self, current: f64, h: f64) -> FmiResult {
         let sim = self.sim.as_mut().expect("initialised");
-        if let Err(why) = Self::check_step(current, h, sim.t) {
-            return Err(Self::step_refused(why, current, h, sim.t));
-        }
         sim.t = current;
         let t_end = current + h;
         // What the event log compares with, taken only when that log is on.
@@ -507,14 +418,10 @@ impl Slave for Instance {
             !(xi.is_some_and(f64::is_finite) && xi_dot.is_some_and(f64::is_finite))
         };
         match sim.step_to(t_end) {
-            Ok(()) if overflowed(sim) => {
-                self.state = FmiState::Error;
-                Err(FmiError::error(format!(
-                    "fmi2DoStep from t = {current} to {t_end} failed: the state is no longer finite (times, steps or inputs beyond what the model can represent); fmi2Reset to start over"
-                )))
-            }
+            Ok(()) if overflowed(sim) => Err(FmiError::error(format!(
+                "fmi2DoStep from t = {current} to {t_end} failed: the state is no longer finite (times, steps or inputs beyond what the model can represent); fmi2Reset to start over"
+            ))),
             Ok(()) => {
-                self.last_successful_time = t_end;
                 self.sync_inputs();
                 if let Some(before) = before {
                     self.log_events(t_end, before);
@@ -524,18 +431,10 @@ impl Slave for Instance {
                 }
                 Ok(())
             }
-            Err(e) => {
-                self.state = FmiState::Error;
-                Err(FmiError::error(format!(
-                    "fmi2DoStep from t = {current} to {t_end} failed: {e}; the state stays at t = {current}"
-                )))
-            }
+            Err(e) => Err(FmiError::error(format!(
+                "fmi2DoStep from t = {current} to {t_end} failed: {e}; the state stays at t = {current}"
+            ))),
         }
-    }
-
-    /// fmi2LastSuccessfulTime.
-    fn last_successful_time(&self) -> f64 {
-        self.last_successful_time
     }
 
     /// fmi2SetRealInputDerivatives: the derivatives of θ_M (orders 1, 2) and ω_M (order 1) at
@@ -543,7 +442,13 @@ impl Slave for Instance {
     /// polynomial over the step (a later call for the same quantity wins); the derivative of
     /// τ_in (order 1) ramps the torque over the step (torque mode). Like the inputs, a
     /// derivative holds until it is set again.
-    fn set_input_derivatives(&mut self, vrs: &[u32], orders: &[i32], values: &[f64]) -> FmiResult {
+    fn set_input_derivatives(
+        &mut self,
+        state: FmiState,
+        vrs: &[u32],
+        orders: &[i32],
+        values: &[f64],
+    ) -> FmiResult {
         let mut targets = Vec::with_capacity(vrs.len());
         for ((vr, order), value) in vrs.iter().zip(orders).zip(values) {
             // Where the derivative is kept: an input variable, or τ_in's rate (None).
@@ -571,7 +476,7 @@ impl Slave for Instance {
                 None => self.tau_in_rate = value,
             }
         }
-        self.inputs_changed();
+        self.inputs_changed(state);
         Ok(())
     }
 
@@ -648,11 +553,6 @@ impl Slave for Instance {
     // Model Exchange (see `model_exchange`).
 
     fn set_time(&mut self, t: f64) -> FmiResult {
-        if !t.is_finite() {
-            return Err(FmiError::error(format!(
-                "time = {t} refused: it must be finite"
-            )));
-        }
         self.model_exchange().set_time(t).map_err(|shaft| {
             FmiError::error(format!(
                 "time = {t:e} refused: the main shaft's motion there is not finite ({shaft:?}), beyond what the model can represent"
@@ -689,11 +589,6 @@ impl Slave for Instance {
         fill("eventIndicators", z, self.current()?.event_indicators())
     }
 
-    fn enter_event_mode(&mut self) -> FmiResult {
-        self.state = FmiState::EventMode;
-        Ok(())
-    }
-
     fn new_discrete_states(&mut self) -> FmiResult<EventInfo> {
         let sim = self.model_exchange();
         let before = sim.impacts();
@@ -714,15 +609,8 @@ impl Slave for Instance {
         })
     }
 
-    fn enter_continuous_time_mode(&mut self) -> FmiResult {
-        self.state = FmiState::ContinuousTimeMode;
-        Ok(())
-    }
-
     fn completed_integrator_step(&mut self) -> FmiResult<bool> {
-        let sim = self.model_exchange();
-        sim.completed_integrator_step();
-        self.last_successful_time = sim.t;
+        self.model_exchange().completed_integrator_step();
         Ok(false)
     }
 }
@@ -730,10 +618,11 @@ impl Slave for Instance {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use fmi2_shell::Fmu;
     use fmi2_shell::fmu_state::{deserialize, serialize};
 
-    fn stepped() -> Instance {
-        let mut i = Instance::new(false, Interface::CoSimulation);
+    fn stepped() -> Fmu<Instance> {
+        let mut i = Fmu::<Instance>::new(false, Interface::CoSimulation);
         i.set_integer(&[vr::excitation], &[1]).unwrap();
         i.enter_initialization_mode().unwrap();
         i.exit_initialization_mode().unwrap();
@@ -745,7 +634,7 @@ mod tests {
     #[test]
     fn serialized_state_round_trip_is_exact() {
         let i = stepped();
-        let back: Instance = deserialize(&serialize(&i)).unwrap();
+        let back: Fmu<Instance> = deserialize(&serialize(&i)).unwrap();
         assert_eq!(serialize(&back), serialize(&i));
     }
 
@@ -755,24 +644,25 @@ mod tests {
     /// (the fuzzer's mended states made fmi2ExitInitializationMode panic).
     #[test]
     fn hand_made_states_are_refused() {
-        let refused = |i: &Instance| deserialize::<Instance>(&serialize(i)).unwrap_err().message;
+        let refused =
+            |i: &Fmu<Instance>| deserialize::<Instance>(&serialize(i)).unwrap_err().message;
         let mut no_sim = stepped();
-        no_sim.sim = None;
+        no_sim.slave.sim = None;
         assert!(refused(&no_sim).contains("without a simulation"));
-        let mut in_event_mode = Instance::new(false, Interface::ModelExchange);
+        let mut in_event_mode = Fmu::<Instance>::new(false, Interface::ModelExchange);
         in_event_mode.state = FmiState::EventMode;
         assert!(refused(&in_event_mode).contains("without a simulation"));
         let mut stepping = stepped();
-        stepping.interface = Interface::ModelExchange;
+        stepping.slave.interface = Interface::ModelExchange;
         assert!(refused(&stepping).contains("ModelExchange instance in state StepComplete"));
         let mut integrating = stepped();
         integrating.state = FmiState::ContinuousTimeMode;
         assert!(refused(&integrating).contains("CoSimulation instance in state Continuous"));
         let mut nan = stepped();
-        nan.values.set_real(vr::omega_M, f64::NAN);
+        nan.slave.values.set_real(vr::omega_M, f64::NAN);
         assert!(refused(&nan).contains("NaN"));
         let mut short = stepped();
-        short.values = values_without_integers();
+        short.slave.values = values_without_integers();
         assert!(refused(&short).contains("Integer values"));
     }
 

@@ -14,7 +14,7 @@ def fmu_path() -> str:
     if not FMU_PATH.is_file():
         pytest.fail(
             f"{FMU_PATH} does not exist: build it first with `make fmu` "
-            "(or `cargo run --release --bin package`), then rerun the tests",
+            "(or `cargo run --release -p packaging -- --model GearRattle`), then rerun the tests",
             pytrace=False,
         )
     return str(FMU_PATH)

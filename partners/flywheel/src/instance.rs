@@ -1,20 +1,18 @@
-//! The co-simulation slave for fmi2-shell: FMI 2.0's calls as methods that return `Ok(())`
-//! or the reason of a refusal. The shell checks the state machine before calling in.
+//! The slave for fmi2-shell: the flywheel's variables and stepping as methods that return
+//! `Ok(())` or the reason of a refusal. The shell applies FMI's rules (state machine, time
+//! checks, what may be set when) before calling in.
 #![allow(non_snake_case)]
 
 use crate::contract::{self, Causality, Kind, LOG_CATEGORIES, VARIABLES, vr};
 use crate::model::{Params, State};
-use fmi2_shell::contract::no_variables;
 use fmi2_shell::values::Values;
 use fmi2_shell::{FmiError, FmiResult, FmiState, Identity, Interface, Log, Slave};
 use serde::{Deserialize, Serialize};
 
-/// Everything that determines the future of an instance (what fmi2GetFMUstate saves), and
-/// its log.
+/// The model's part of what determines the future of an instance (what fmi2GetFMUstate
+/// saves), and its log.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Instance {
-    state: FmiState,
-    t: f64,
     pub y: State,
     /// Parameters and the input, by value reference.
     values: Values,
@@ -58,14 +56,13 @@ impl Slave for Instance {
         model_identifier: contract::MODEL_IDENTIFIER,
         log_categories: LOG_CATEGORIES,
         state_magic: *b"FLYS",
-        state_version: 2,
+        state_version: 3,
         model_exchange: false,
+        variable: contract::variable,
     };
 
     fn new(logging_on: bool, _interface: Interface) -> Self {
         Instance {
-            state: FmiState::Instantiated,
-            t: 0.0,
             y: [0.0; 4],
             values: Values::start(VARIABLES),
             tau_dot: 0.0,
@@ -78,25 +75,11 @@ impl Slave for Instance {
         &mut self.log
     }
 
-    fn state(&self) -> FmiState {
-        self.state
-    }
-
-    fn set_state(&mut self, state: FmiState) {
-        self.state = state;
-    }
-
-    fn setup_experiment(&mut self, _tolerance: Option<f64>, start_time: f64) -> FmiResult {
-        self.t = start_time;
-        Ok(())
-    }
-
     /// Checks the parameters and sets the initial state: both shafts at idle speed.
     fn exit_initialization_mode(&mut self) -> FmiResult {
         let p = self.build()?;
         self.y = p.initial_state();
         self.params = Some(p);
-        self.state = FmiState::StepComplete;
         Ok(())
     }
 
@@ -114,44 +97,21 @@ impl Slave for Instance {
         Ok(())
     }
 
-    fn get_integer(&mut self, vrs: &[u32], _out: &mut [i32]) -> FmiResult {
-        no_variables("Integer", vrs)
-    }
-
-    /// Sets parameters (before fmi2ExitInitializationMode) and the input. The whole call is
-    /// checked first: a refused call changes nothing.
-    fn set_real(&mut self, vrs: &[u32], values: &[f64]) -> FmiResult {
-        for (vr, value) in vrs.iter().zip(values) {
-            contract::variable(Kind::Real, *vr)?.settable_to(self.state, *value)?;
-        }
+    /// Sets parameters (before fmi2ExitInitializationMode) and the input (the shell has
+    /// checked the whole call).
+    fn set_real(&mut self, _state: FmiState, vrs: &[u32], values: &[f64]) -> FmiResult {
         for (vr, value) in vrs.iter().zip(values) {
             self.values.set_real(*vr, *value);
         }
         Ok(())
     }
 
-    fn set_integer(&mut self, vrs: &[u32], _values: &[i32]) -> FmiResult {
-        no_variables("Integer", vrs)
-    }
-
-    fn do_step(&mut self, current: f64, h: f64) -> FmiResult {
-        if !(h > 0.0 && h.is_finite()) {
-            return Err(error(format!(
-                "communicationStepSize = {h:e} refused: it must be finite and > 0"
-            )));
-        }
-        // Masters accumulate the communication point: rounding drift is accepted.
-        if !current.is_finite() || (current - self.t).abs() > 1e-9 * self.t.abs().max(h).max(1e-3) {
-            return Err(error(format!(
-                "currentCommunicationPoint = {current} does not match the instance's time {}",
-                self.t
-            )));
-        }
+    /// One step of h from `current` (the shell has checked both).
+    fn step(&mut self, current: f64, h: f64) -> FmiResult {
         let p = self.params.expect("initialised");
         let tau = self.tau_M();
         let y = p.advance(&self.y, tau, self.tau_dot, h);
         if y.iter().any(|x| !x.is_finite()) {
-            self.state = FmiState::Error;
             return Err(error(format!(
                 "the state is no longer finite at t = {}",
                 current + h
@@ -160,16 +120,17 @@ impl Slave for Instance {
         self.y = y;
         // The input follows its ramp until the master sets it again.
         self.values.set_real(vr::tau_M, tau + self.tau_dot * h);
-        self.t = current + h;
         Ok(())
     }
 
-    fn last_successful_time(&self) -> f64 {
-        self.t
-    }
-
     /// fmi2SetRealInputDerivatives: order 1 of tau_M, a ramp over the following steps.
-    fn set_input_derivatives(&mut self, vrs: &[u32], orders: &[i32], values: &[f64]) -> FmiResult {
+    fn set_input_derivatives(
+        &mut self,
+        _state: FmiState,
+        vrs: &[u32],
+        orders: &[i32],
+        values: &[f64],
+    ) -> FmiResult {
         for ((vr, order), value) in vrs.iter().zip(orders).zip(values) {
             if *vr != vr::tau_M || *order != 1 || !value.is_finite() {
                 return Err(error(format!(
@@ -195,11 +156,11 @@ impl Slave for Instance {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use fmi2_shell::Fmu;
     use fmi2_shell::fmu_state::{deserialize, serialize};
-    use fmi2_shell::slave::{restore, snapshot};
 
-    fn running() -> Instance {
-        let mut i = Instance::new(false, Interface::CoSimulation);
+    fn running() -> Fmu<Instance> {
+        let mut i = Fmu::<Instance>::new(false, Interface::CoSimulation);
         i.setup_experiment(None, 0.0).unwrap();
         i.enter_initialization_mode().unwrap();
         i.exit_initialization_mode().unwrap();
@@ -213,14 +174,14 @@ mod tests {
         i.set_input_derivatives(&[vr::tau_M], &[1], &[30.0])
             .unwrap();
         i.do_step(0.0, 1e-3).unwrap();
-        let saved: Instance = deserialize(&serialize(&i)).unwrap();
+        let saved: Fmu<Instance> = deserialize(&serialize(&i)).unwrap();
         i.do_step(1e-3, 2.5e-3).unwrap();
         let first = serialize(&i);
-        let mut j = Instance::new(false, Interface::CoSimulation);
-        restore(&mut j, &saved);
+        let mut j = Fmu::<Instance>::new(false, Interface::CoSimulation);
+        j.restore(&saved).unwrap();
         j.do_step(1e-3, 2.5e-3).unwrap();
         assert_eq!(serialize(&j), first);
-        assert_eq!(serialize(&snapshot(&j)), first);
+        assert_eq!(serialize(&j.snapshot()), first);
     }
 
     #[test]
@@ -242,7 +203,7 @@ mod tests {
 
     #[test]
     fn invalid_parameter_keeps_initialisation_mode() {
-        let mut i = Instance::new(false, Interface::CoSimulation);
+        let mut i = Fmu::<Instance>::new(false, Interface::CoSimulation);
         i.enter_initialization_mode().unwrap();
         i.set_real(&[vr::I_M], &[0.0]).unwrap();
         assert!(
@@ -251,7 +212,7 @@ mod tests {
                 .message
                 .contains("I_M")
         );
-        assert_eq!(i.state(), FmiState::InitializationMode);
+        assert_eq!(i.state, FmiState::InitializationMode);
         i.set_real(&[vr::I_M], &[0.01]).unwrap();
         i.exit_initialization_mode().unwrap();
     }
@@ -265,7 +226,7 @@ mod tests {
         for k in 0..10 {
             b.do_step(f64::from(k) * 1e-4, 1e-4).unwrap();
         }
-        for (x, y) in a.y.iter().zip(&b.y) {
+        for (x, y) in a.slave.y.iter().zip(&b.slave.y) {
             assert!((x - y).abs() <= 1e-12 * x.abs().max(1.0));
         }
     }

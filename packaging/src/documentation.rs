@@ -1,7 +1,7 @@
-//! `documentation/index.html` inside the FMU: the equations of MODEL.md with the paper's
-//! numbers, and the parameter and variable tables generated from the contract.
+//! `documentation/index.html` inside GearRattle's FMU: the equations of MODEL.md with the
+//! paper's numbers, and the parameter and variable tables generated from the contract.
 
-use crate::contract::{Causality, VARIABLES};
+use crate::contracts::gear_rattle::{Causality, VARIABLES};
 
 const HEAD: &str = r#"<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8"><title>GearRattle</title>
