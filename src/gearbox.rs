@@ -147,23 +147,37 @@ impl Gearbox {
         }
     }
 
-    /// GEARBOX.md §6's start at t0: φ = 0, the input side at the flywheel's speed, every
-    /// loose gear at rigid meshing speed (ξ_i' = 0) mid-backlash; θ_F = 0 (the engine) or
-    /// the input's; ω_F(0) under a ramp.
-    pub fn start(params: &GearboxParams, flywheel: Flywheel, t0: f64) -> (Self, State) {
+    /// GEARBOX.md §6's start: φ = 0, the input side at the flywheel's speed, every loose
+    /// gear at rigid meshing speed (ξ_i' = 0) mid-backlash; under an engine ramp ω_F(0) (and
+    /// θ_F = 0) as states.
+    pub fn start(params: &GearboxParams, flywheel: Flywheel) -> (Self, State) {
         let mut y = [0.0; N];
         for (i, gear) in params.gears.iter().enumerate() {
             y[xi(i)] = 0.5 * gear.pair.G;
         }
-        let mut sys = Gearbox::new(params, flywheel, &y);
-        let n = sys.n;
-        match flywheel {
-            Flywheel::Engine(e) if !e.is_steady() => y[omega_F(n)] = e.omega_start(),
-            Flywheel::Inputs(p) => y[THETA_F] = p.at(t0).theta,
-            Flywheel::Engine(_) => {}
+        let sys = Gearbox::new(params, flywheel, &y);
+        if let Flywheel::Engine(e) = flywheel
+            && !e.is_steady()
+        {
+            y[omega_F(sys.n)] = e.omega_start();
         }
-        sys.last_crossed = 0;
         (sys, y)
+    }
+
+    /// New flywheel motion from the drivetrain at t (θ_F, ω_F, α_F, extrapolated from there
+    /// on). The input side does not move, so the twist follows the flywheel: φ and φ' change
+    /// by the jumps of θ_F and ω_F (the ξ_i, relative to the input side, stay); the damper's
+    /// stage settles where φ lands. Returns the edges crossed; the caller invalidates its
+    /// solver.
+    pub fn set_flywheel(&mut self, t: f64, y: &mut State, shaft: Shaft) -> usize {
+        let old = self.flywheel_at(t, y);
+        y[PHI] += shaft.theta - old.theta;
+        y[PHI_DOT] += shaft.omega - old.omega;
+        self.flywheel = Flywheel::Inputs(Polynomial {
+            t0: t,
+            at_t0: shaft,
+        });
+        self.settle(t, y)
     }
 
     /// How many loose gears the box has.

@@ -16,7 +16,7 @@ use gear_rattle::physics::{Dynamics, Engine, Excitation, Polynomial, Shaft};
 use gear_rattle::rattle::{self, Rattle};
 
 fn engine_driven(params: &GearboxParams) -> (Gearbox, State) {
-    Gearbox::start(params, Flywheel::Engine(Engine::new(&params.engine)), 0.0)
+    Gearbox::start(params, Flywheel::Engine(Engine::new(&params.engine)))
 }
 
 /// Runs from (sys, y) to t_end in chunks of `dt`, calling `each` after every chunk.
@@ -310,4 +310,48 @@ fn a_ramp_integrates_the_flywheel() {
     assert!((r.input.omega_F - expected).abs() < 1e-9 * expected);
     assert_eq!(r.input.theta_I, r.input.theta_F - y[PHI]);
     assert!(r.input.theta_F > 0.3 * 800.0 * std::f64::consts::PI / 30.0);
+}
+
+/// Driven by inputs: new flywheel motion moves the twist, not the input side (θ_I, ω_I and
+/// every ξ_i stay), and the damper's stage follows φ; between inputs the flywheel turns as
+/// extrapolated from them.
+#[test]
+fn new_inputs_move_the_twist_not_the_input_side() {
+    let p = GearboxParams::default_box();
+    let first = Shaft {
+        theta: 100.0,
+        omega: 84.0,
+        alpha: 300.0,
+    };
+    let inputs = Flywheel::Inputs(Polynomial {
+        t0: 0.0,
+        at_t0: first,
+    });
+    let (mut sys, mut y) = Gearbox::start(&p, inputs);
+    let mut solver = Solver::new(sys.tolerance(1e-7));
+    let mut t = 0.0;
+    solver.advance(&mut sys, &mut t, &mut y, 0.01).unwrap();
+    let before = sys.readout(t, &y);
+    assert!((before.input.theta_F - (100.0 + 0.84 + 0.5 * 300.0 * 1e-4)).abs() < 1e-12);
+    let next = Shaft {
+        theta: before.input.theta_F + 0.08,
+        omega: before.input.omega_F + 2.0,
+        alpha: -500.0,
+    };
+    let crossed = sys.set_flywheel(t, &mut y, next);
+    solver.invalidate();
+    let after = sys.readout(t, &y);
+    assert!((after.input.theta_I - before.input.theta_I).abs() < 1e-12);
+    assert!((after.input.omega_I - before.input.omega_I).abs() < 1e-12);
+    assert!((after.input.phi - before.input.phi - 0.08).abs() < 1e-12);
+    assert_eq!(after.input.alpha_F, -500.0);
+    for (a, b) in after.gears.iter().zip(&before.gears) {
+        assert_eq!((a.xi, a.xi_dot), (b.xi, b.xi_dot));
+    }
+    let (lo, hi) = sys.piece(0);
+    assert!(
+        lo <= y[PHI] && y[PHI] <= hi,
+        "stage settled ({crossed} crossed)"
+    );
+    solver.advance(&mut sys, &mut t, &mut y, 0.02).unwrap();
 }
