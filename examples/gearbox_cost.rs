@@ -23,7 +23,7 @@ struct Run {
 
 /// 2 s of `p` from GEARBOX.md §6's start, sampled every 0.1 ms from 0.5 s.
 fn run(p: &GearboxParams) -> Run {
-    let (mut sys, mut y) = Gearbox::start(p, Flywheel::Engine(Engine::new(&p.engine)));
+    let (mut sys, mut y) = Gearbox::start(p, Flywheel::Engine(Engine::new(&p.engine))).unwrap();
     let mut solver = Solver::new(sys.tolerance(1e-6));
     solver.interpolate_ends = true;
     let count = |sys: &Gearbox| -> Vec<u64> {

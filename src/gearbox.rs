@@ -27,7 +27,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::integrator::{Crossing, Edge, Piecewise, System, Tolerance};
 use crate::physics::{
-    Damper, Dynamics, Engine, Polynomial, Region, Shaft, Stage, contact::ContactForce,
+    Damper, Dynamics, Engine, GearParams, Polynomial, Region, Shaft, Stage, contact::ContactForce,
 };
 use crate::rattle::{Impacts, LOCAL_SHARE, enter_region, scales};
 pub use params::{GearboxParamError, GearboxParams, LooseGear, MAX_GEARS};
@@ -112,13 +112,14 @@ pub(crate) struct Loads {
 }
 
 impl Gearbox {
-    /// The box of valid `params` (see [`GearboxParams::validate`]) with the twist at φ and
-    /// each ξ_i at `xi[i]` (for their stage and regions), driven by `flywheel`.
+    /// The box of valid `params` (see [`GearboxParams::validate`]) with the stage and
+    /// regions of φ and the ξ_i in `state`, driven by `flywheel`.
     pub fn new(params: &GearboxParams, flywheel: Flywheel, state: &State) -> Self {
         let drag = params.oil.drag_factor(params.T_oil);
         let damper = Damper::new(params.damper);
+        // The slots of gears the box does not have hold a gear that is never read.
         let mut gears = [Gear {
-            dynamics: Dynamics::new(params.gears[0].pair),
+            dynamics: Dynamics::new(GearParams::paper()),
             rho: 1.0,
             region: Region::Gap,
             impacts: Impacts::default(),
@@ -147,10 +148,14 @@ impl Gearbox {
         }
     }
 
-    /// GEARBOX.md §6's start: φ = 0, the input side at the flywheel's speed, every loose
-    /// gear at rigid meshing speed (ξ_i' = 0) mid-backlash; under an engine ramp ω_F(0) (and
-    /// θ_F = 0) as states.
-    pub fn start(params: &GearboxParams, flywheel: Flywheel) -> (Self, State) {
+    /// GEARBOX.md §6's start for `params`, once validated: φ = 0, the input side at the
+    /// flywheel's speed, every loose gear at rigid meshing speed (ξ_i' = 0) mid-backlash;
+    /// under an engine ramp ω_F(0) (and θ_F = 0) as states.
+    pub fn start(
+        params: &GearboxParams,
+        flywheel: Flywheel,
+    ) -> Result<(Self, State), GearboxParamError> {
+        params.validate()?;
         let mut y = [0.0; N];
         for (i, gear) in params.gears.iter().enumerate() {
             y[xi(i)] = 0.5 * gear.pair.G;
@@ -161,7 +166,7 @@ impl Gearbox {
         {
             y[omega_F(sys.n)] = e.omega_start();
         }
-        (sys, y)
+        Ok((sys, y))
     }
 
     /// New flywheel motion from the drivetrain at t (θ_F, ω_F, α_F, extrapolated from there

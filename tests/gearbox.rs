@@ -16,7 +16,7 @@ use gear_rattle::physics::{Dynamics, Engine, Excitation, Polynomial, Shaft};
 use gear_rattle::rattle::{self, Rattle};
 
 fn engine_driven(params: &GearboxParams) -> (Gearbox, State) {
-    Gearbox::start(params, Flywheel::Engine(Engine::new(&params.engine)))
+    Gearbox::start(params, Flywheel::Engine(Engine::new(&params.engine))).unwrap()
 }
 
 /// Runs from (sys, y) to t_end in chunks of `dt`, calling `each` after every chunk.
@@ -327,7 +327,7 @@ fn new_inputs_move_the_twist_not_the_input_side() {
         t0: 0.0,
         at_t0: first,
     });
-    let (mut sys, mut y) = Gearbox::start(&p, inputs);
+    let (mut sys, mut y) = Gearbox::start(&p, inputs).unwrap();
     let mut solver = Solver::new(sys.tolerance(1e-7));
     let mut t = 0.0;
     solver.advance(&mut sys, &mut t, &mut y, 0.01).unwrap();
@@ -354,4 +354,16 @@ fn new_inputs_move_the_twist_not_the_input_side() {
         "stage settled ({crossed} crossed)"
     );
     solver.advance(&mut sys, &mut t, &mut y, 0.02).unwrap();
+}
+
+/// A box starts only from valid parameters, the error naming the one at fault.
+#[test]
+fn start_refuses_invalid_parameters() {
+    let mut p = GearboxParams::default_box();
+    p.gears[1].pair.I_L = 0.0;
+    let error = Gearbox::start(&p, Flywheel::Engine(Engine::new(&p.engine))).unwrap_err();
+    assert_eq!(
+        error.to_string(),
+        "gear 2: parameter I_L = 0e0 is invalid: allowed finite and > 0"
+    );
 }
