@@ -19,6 +19,16 @@ fn engine_driven(params: &GearboxParams) -> (Gearbox, State) {
     Gearbox::start(params, Flywheel::Engine(Engine::new(&params.engine))).unwrap()
 }
 
+/// The flywheel's θ_F, ω_F, α_F at t0 from the drivetrain, and the drive they make.
+fn driven_by_inputs(t0: f64, [theta, omega, alpha]: [f64; 3]) -> (Shaft, Flywheel) {
+    let at_t0 = Shaft {
+        theta,
+        omega,
+        alpha,
+    };
+    (at_t0, Flywheel::Inputs(Polynomial { t0, at_t0 }))
+}
+
 /// Runs from (sys, y) to t_end in chunks of `dt`, calling `each` after every chunk.
 fn run(
     sys: &mut Gearbox,
@@ -152,15 +162,7 @@ fn one_gear_follows_the_gear_pairs_right_hand_side() {
     p.gears[0].pair.B = 0.01;
     p.gears[0].pair.omega_S = 2.0;
     let q = p.gears[0].pair;
-    let flywheel = Shaft {
-        theta: 3.0,
-        omega: 90.0,
-        alpha: 700.0,
-    };
-    let inputs = Flywheel::Inputs(Polynomial {
-        t0: 0.01,
-        at_t0: flywheel,
-    });
+    let (flywheel, inputs) = driven_by_inputs(0.01, [3.0, 90.0, 700.0]);
     let (phi, phi_dot) = (0.02, 1.3);
     for xi0 in [-3e-6, -0.4e-6, 40e-6, q.G + 0.3e-6, q.G + 2e-6] {
         let xi_dot0 = -0.02;
@@ -318,15 +320,7 @@ fn a_ramp_integrates_the_flywheel() {
 #[test]
 fn new_inputs_move_the_twist_not_the_input_side() {
     let p = GearboxParams::default_box();
-    let first = Shaft {
-        theta: 100.0,
-        omega: 84.0,
-        alpha: 300.0,
-    };
-    let inputs = Flywheel::Inputs(Polynomial {
-        t0: 0.0,
-        at_t0: first,
-    });
+    let (_, inputs) = driven_by_inputs(0.0, [100.0, 84.0, 300.0]);
     let (mut sys, mut y) = Gearbox::start(&p, inputs).unwrap();
     let mut solver = Solver::new(sys.tolerance(1e-7));
     let mut t = 0.0;
