@@ -46,5 +46,5 @@ bench-profile: | libclang
 ## bench-reference: the independent reference solutions of the benchmark scenes
 bench-reference: $(BENCH_REF)
 
-$(BENCH_REF): scripts/bench_reference.py tests/python/reference.py | $(VENV)/.installed
+$(BENCH_REF): scripts/bench_reference.py | $(VENV)/.installed
 	$(PY) scripts/bench_reference.py --out $(BENCH_DIR)/reference

@@ -1,4 +1,4 @@
-# Reliability checks of the C API (issue 19; docs/RELIABILITY.md says what each one proves):
+# Reliability checks of the C API (docs/RELIABILITY.md says what each one proves):
 #   make fuzz          libFuzzer + AddressSanitizer over random fmi2 call sequences
 #                      (fuzz/, cargo-fuzz on the nightly toolchain), FUZZ_SECONDS long
 #   make test-memcheck valgrind memcheck over the lifecycle and thread tests (release build)

@@ -1,4 +1,4 @@
-# Masters (issue 5): GearRattle coupled with a drivetrain partner FMU, partners/flywheel
+# Masters: GearRattle coupled with a drivetrain partner FMU, partners/flywheel
 # (an engine flywheel with firing acyclism driving the main shaft through a clutch damper),
 # in fmpy, libcosim and Ecos, against a monolithic reference (tests/masters, run by pytest
 # with the Python tests), and the coupling-error study (`make coupling-study`, not in `make test`).

@@ -1,4 +1,4 @@
-# Portable binaries (issue 19), built with zig through cargo-zigbuild:
+# Portable binaries, built with zig through cargo-zigbuild:
 #   linux64   binaries/linux64/GearRattle.so for glibc 2.17 (RHEL 7 and every later Linux),
 #   darwin64  binaries/darwin64/GearRattle.dylib, universal (x86_64 + arm64), macOS 11 or later,
 # and every binary of the FMU stripped when packaged: the unstripped copies, with their line
@@ -22,7 +22,7 @@ TEST_TARGETS += test-portable
 
 # Each binary is built as a cdylib alone (`cargo rustc --crate-type cdylib`): with the rlib
 # crate type of Cargo.toml beside it, LTO keeps every Rust function public and the linkers
-# keep much of them (win64 was four times larger: docs/DECISIONS.md D23).
+# keep much of them (win64 four times larger: docs/DECISIONS.md D23).
 # cargo-zigbuild runs from target/: zig prints its include directories relative to the working
 # directory when they lie below it (the .venv does), and cargo-zigbuild hands them as they are to
 # bindgen (fmi-sys), which runs elsewhere and then finds no stddef.h. cargo still reads

@@ -1,4 +1,4 @@
-# Stability report (issue 4): the stress suite of tests/python/stress_cases.py (the same cases
+# Stability report: the stress suite of python/gearrattle/stress.py (the same cases
 # and checks as tests/python/test_stress.py, which runs in `make test`) as one table in
 # docs/STABILITY.md: parameters, method chosen, steps, RHS evaluations, CPU-time ratio to S1,
 # error, pass/fail. About two minutes on the 2-core machine (the 1 h case takes ~20 s of it).
@@ -10,6 +10,6 @@ STABILITY_FLAGS ?=
 
 .PHONY: stability
 
-## stability: the stress suite of issue 4 as a report -> docs/STABILITY.md
+## stability: the stress suite as a report -> docs/STABILITY.md
 stability: fmu $(VENV)/.installed
 	$(PY) scripts/stability_report.py --fmu $(FMU) --out $(STABILITY_OUT) $(STABILITY_FLAGS)

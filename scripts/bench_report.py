@@ -19,7 +19,6 @@ import math
 import pathlib
 import re
 import statistics
-import subprocess
 import time
 
 import matplotlib
@@ -27,6 +26,8 @@ import matplotlib.ticker
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+
+from gearrattle.machine import lscpu  # noqa: E402
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 BENCH = ROOT / "target" / "bench"
@@ -151,19 +152,6 @@ def side_by_side_rows(eq):
         c, e, rt, reps, h = eq[n]
         rows.append(f"| {n} | {rt:.3g} | {e:.2e} m | {fmt_t(c)} | {reps} | {h:.3g} | {c / gr:.2f} |")
     return "\n".join(rows)
-
-
-def lscpu():
-    try:
-        out = subprocess.run(["lscpu"], capture_output=True, text=True, check=True).stdout
-    except (OSError, subprocess.CalledProcessError):
-        return {}
-    d = {}
-    for line in out.splitlines():
-        if ":" in line:
-            k, v = line.split(":", 1)
-            d[k.strip()] = v.strip()
-    return d
 
 
 def noise(rows):

@@ -16,3 +16,19 @@ pub const MODEL_DESCRIPTION_XML: &str =
 pub fn with_derivative() -> impl Iterator<Item = &'static str> {
     VARIABLES.iter().filter(|v| v.derivative).map(|v| v.name)
 }
+
+/// docs/PARAMETERS.md: the parameters and inputs with their units, defaults and ranges
+/// (`make docs-parameters` writes it; a test checks that the file is up to date).
+pub fn parameters_markdown() -> String {
+    format!(
+        "# {MODEL_NAME}'s parameters and inputs\n\n\
+         Generated from the contract, modelDescription/{MODEL_NAME}.toml, by `make docs-parameters`: \
+         do not edit. The FMU refuses a parameter outside its range at \
+         fmi2ExitInitializationMode with a message naming it, its value and its range; the study \
+         runner (`gearrattle-study`) refuses it before anything runs. Real values must also be \
+         finite. Units are SI; the defaults are the paper's values (docs/MODEL.md §4).\n\n\
+         ## Parameters\n\n{}\n## Inputs\n\n{}",
+        fmi2_shell::table::markdown(VARIABLES, Causality::Parameter),
+        fmi2_shell::table::markdown(VARIABLES, Causality::Input)
+    )
+}

@@ -1,5 +1,5 @@
 //! GearRattle: the gear-pair rattle model of Dion, Le Moyne, Chevallier and Sebbah (MSSP
-//! 2009) as an FMI 2.0 Co-Simulation FMU.
+//! 2009) as an FMI 2.0 FMU for Co-Simulation and Model Exchange.
 //!
 //! Layers, each knowing nothing of the ones above it:
 //! - [`math`]: cheap elementary functions for the right-hand side (cube root, sine);
@@ -11,7 +11,8 @@
 //!   (the shaft's motion imposed; [`rattle::torque`]: driven by a torque, 7 states);
 //! - [`gearbox`]: the gearbox of GEARBOX.md (up to 8 loose gears behind a clutch damper) as
 //!   a piecewise ODE with one guard per gear and one for the damper;
-//! - [`instance`]: the co-simulation slave (FMI state machine, variables, stepping);
+//! - [`instance`]: one FMU instance (variables, co-simulation stepping, Model Exchange's
+//!   states and events);
 //! - the `fmi2*` C exports of Co-Simulation and Model Exchange: [`fmi2_shell`]'s, around
 //!   [`instance::Instance`];
 //! - [`contract`]: value references and the model description, generated from

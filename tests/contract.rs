@@ -261,3 +261,100 @@ fn moves(sim: &mut Simulation, v: &Variable, known: u32) -> bool {
     assert_eq!(read(sim), before, "{}: known {known} set back", v.name);
     before != after
 }
+
+/// Each parameter's range as MODEL.md §4 and §5 give it, written out here: the contract's
+/// ranges must refuse a value just outside and admit the bound itself where it is inclusive.
+const RANGES: [(&str, f64, Option<f64>, &str); 13] = [
+    // (name, a value outside, the inclusive bound or None, the range the message states)
+    ("I_L", 0.0, None, "I_L > 0"),
+    ("r_L", -0.037, None, "r_L > 0"),
+    ("r_M", 0.0, None, "r_M > 0"),
+    ("K_star", -3e6, None, "K_star > 0"),
+    ("alpha", 0.9, Some(1.0), "alpha >= 1"),
+    ("epsilon", -1e-9, Some(0.0), "epsilon >= 0"),
+    ("G", 0.0, None, "G > 0"),
+    ("C_LM", -1.0, Some(0.0), "C_LM >= 0"),
+    ("C", -1e-3, Some(0.0), "C >= 0"),
+    ("f_exc", 0.0, None, "f_exc > 0"),
+    ("I_M", 0.0, None, "I_M > 0"),
+    ("stats_from", -1e-3, Some(0.0), "stats_from >= 0"),
+    ("G", f64::INFINITY, None, "G > 0 (finite)"),
+];
+
+fn real_vr(name: &str) -> u32 {
+    VARIABLES
+        .iter()
+        .find(|v| v.name == name && v.kind == Kind::Real)
+        .unwrap()
+        .vr
+}
+
+#[test]
+fn parameters_outside_their_range_are_refused_naming_it() {
+    for (name, outside, bound, range) in RANGES {
+        let mut values = Values::start(VARIABLES);
+        values.set_real(real_vr(name), outside);
+        let Err(e) = Simulation::new(&values, 0.0, 0.0, 1e-6) else {
+            panic!("{name} = {outside} accepted");
+        };
+        let message = e.message;
+        let value = format!("{outside:e}");
+        for words in [name, &value, range] {
+            assert!(message.contains(words), "{name}: {message}");
+        }
+        if let Some(b) = bound {
+            values.set_real(real_vr(name), b);
+            assert!(
+                Simulation::new(&values, 0.0, 0.0, 1e-6).is_ok(),
+                "{name} = {b} refused"
+            );
+        }
+    }
+    // The smallest positive double is inside I_L > 0.
+    let mut values = Values::start(VARIABLES);
+    values.set_real(vr::I_L, f64::from_bits(1));
+    assert!(Simulation::new(&values, 0.0, 0.0, 1e-6).is_ok());
+    for (name, value) in [("excitation", 3), ("solver", -1)] {
+        let mut values = Values::start(VARIABLES);
+        let vr = VARIABLES.iter().find(|v| v.name == name).unwrap().vr;
+        values.set_integer(vr, value);
+        let Err(e) = Simulation::new(&values, 0.0, 0.0, 1e-6) else {
+            panic!("{name} = {value} accepted");
+        };
+        let expected = format!("parameter {name} = {value} is invalid: allowed 0 <= {name} <= 2");
+        assert!(e.message.contains(&expected), "{}", e.message);
+    }
+}
+
+/// The model description carries each range: inclusive bounds as min/max, an exclusive one
+/// as the nearest double inside, and the statement at the end of the description.
+#[test]
+fn the_model_description_states_every_range() {
+    let xml = gear_rattle::contract::MODEL_DESCRIPTION_XML;
+    let element = |name: &str| {
+        let start = xml.find(&format!("name=\"{name}\"")).unwrap();
+        let end = start + xml[start..].find("</ScalarVariable>").unwrap();
+        &xml[start..end]
+    };
+    for (name, _, bound, range) in &RANGES[..12] {
+        let e = element(name);
+        let min = match bound {
+            Some(b) => format!("min=\"{b:?}\""),
+            None => "min=\"5e-324\"".to_string(),
+        };
+        assert!(e.contains(&min), "{name}: {e}");
+        let escaped = range.replace('<', "&lt;").replace('>', "&gt;");
+        assert!(e.contains(&format!("(range: {escaped})\"")), "{name}: {e}");
+    }
+    assert!(!element("B").contains("min="));
+}
+
+#[test]
+fn parameters_md_is_generated_from_the_contract() {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/docs/PARAMETERS.md");
+    let on_disk = std::fs::read_to_string(path).unwrap_or_default();
+    assert!(
+        on_disk == gear_rattle::contract::parameters_markdown(),
+        "docs/PARAMETERS.md is not the contract's tables: run `make docs-parameters`"
+    );
+}

@@ -354,10 +354,7 @@ fn new_inputs_move_the_twist_not_the_input_side() {
 #[test]
 fn start_refuses_invalid_parameters() {
     let mut p = GearboxParams::default_box();
-    p.gears[1].pair.I_L = 0.0;
+    p.damper.k_2 = 0.5 * p.damper.k_1;
     let error = Gearbox::start(&p, Flywheel::Engine(Engine::new(&p.engine))).unwrap_err();
-    assert_eq!(
-        error.to_string(),
-        "gear 2: parameter I_L = 0e0 is invalid: allowed finite and > 0"
-    );
+    assert!(error.to_string().starts_with("parameter k_2 = "), "{error}");
 }

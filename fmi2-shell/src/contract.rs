@@ -1,9 +1,10 @@
 //! The types of a model's contract, as the generated constants use them
-//! ([`build`](crate::build) writes them from the contract TOML), and the checks of the
-//! fmi2Set* calls against it.
+//! ([`build`](crate::build) writes them from the contract TOML), the checks of the
+//! fmi2Set* calls against it, and of the parameters against their ranges.
 
 use crate::state::FmiState;
 use crate::status::{FmiError, FmiResult};
+use crate::values::Values;
 
 /// FMI 2.0 base type of a variable.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -25,6 +26,78 @@ pub enum Causality {
     Local,
 }
 
+/// One end of a variable's range.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Bound {
+    /// No bound on this side.
+    None,
+    /// The value may equal the bound (FMI's min/max).
+    Inclusive(f64),
+    /// The value must stay strictly beyond the bound (I_L > 0). FMI 2.0's XML has no such
+    /// attribute: it carries the nearest double inside the range, which admits the same
+    /// doubles.
+    Exclusive(f64),
+}
+
+/// The values a variable may take (besides being finite, for a Real).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Range {
+    pub min: Bound,
+    pub max: Bound,
+}
+
+impl Range {
+    /// Any value.
+    pub const ANY: Range = Range {
+        min: Bound::None,
+        max: Bound::None,
+    };
+
+    pub fn contains(&self, x: f64) -> bool {
+        let above = match self.min {
+            Bound::None => true,
+            Bound::Inclusive(b) => x >= b,
+            Bound::Exclusive(b) => x > b,
+        };
+        let below = match self.max {
+            Bound::None => true,
+            Bound::Inclusive(b) => x <= b,
+            Bound::Exclusive(b) => x < b,
+        };
+        above && below
+    }
+
+    /// The range as a statement on `name`: "I_L > 0", "0 <= excitation <= 2", "x < 1";
+    /// empty without bounds. The model description's descriptions end with it, in
+    /// parentheses after "range: ", and the study runner reads it there.
+    pub fn statement(&self, name: &str) -> String {
+        let op = |b: &Bound| match b {
+            Bound::Inclusive(x) => Some(("<=", *x)),
+            Bound::Exclusive(x) => Some(("<", *x)),
+            Bound::None => None,
+        };
+        match (op(&self.min), op(&self.max)) {
+            (None, None) => String::new(),
+            (Some((o, lo)), None) => format!("{name} {} {}", o.replace('<', ">"), number(lo)),
+            (None, Some((o, hi))) => format!("{name} {o} {}", number(hi)),
+            (Some((o1, lo)), Some((o2, hi))) => {
+                format!("{} {o1} {name} {o2} {}", number(lo), number(hi))
+            }
+        }
+    }
+}
+
+/// A number as the statements and the documentation's tables write it: whole numbers without
+/// a fraction, others in Rust's shortest round-trip form (0.05236, 1e-6), which Python's
+/// float() reads back exactly.
+pub fn number(x: f64) -> String {
+    if x.fract() == 0.0 && x.abs() < 1e15 {
+        format!("{x:.0}")
+    } else {
+        format!("{x:?}")
+    }
+}
+
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Start {
     None,
@@ -42,6 +115,8 @@ pub struct Variable {
     pub start: Start,
     /// SI unit as named in UnitDefinitions ("" for dimensionless).
     pub unit: &'static str,
+    /// Parameters: the values the model accepts (checked by [`check_parameters`]).
+    pub range: Range,
     /// Outputs and state derivatives: the inputs and continuous states it depends on at once
     /// (ModelStructure's dependencies).
     pub depends_on: &'static [&'static str],
@@ -77,6 +152,37 @@ impl Variable {
             )))
         }
     }
+}
+
+/// Checks every parameter against its range, in the contract's order: the first one outside
+/// is refused with a message naming it, its value and its range.
+pub fn check_parameters(variables: &[Variable], values: &Values) -> FmiResult {
+    for v in variables
+        .iter()
+        .filter(|v| v.causality == Causality::Parameter)
+    {
+        let (value, shown) = match v.kind {
+            Kind::Real => (values.real(v.vr), format!("{:e}", values.real(v.vr))),
+            Kind::Integer => (
+                values.integer(v.vr) as f64,
+                values.integer(v.vr).to_string(),
+            ),
+        };
+        let finite = v.kind == Kind::Integer || value.is_finite();
+        if !(finite && v.range.contains(value)) {
+            let statement = v.range.statement(v.name);
+            let allowed = match (v.kind, statement.is_empty()) {
+                (Kind::Real, true) => "finite values".to_string(),
+                (Kind::Real, false) => format!("{statement} (finite)"),
+                (Kind::Integer, _) => statement,
+            };
+            return Err(FmiError::error(format!(
+                "parameter {} = {shown} is invalid: allowed {allowed}",
+                v.name
+            )));
+        }
+    }
+    Ok(())
 }
 
 /// The error of a value reference the contract has no variable of that kind for.

@@ -11,7 +11,8 @@
 //!   ([`values`]);
 //! - the types of the contract and the checks of fmi2Set* against it ([`contract`]) and, for
 //!   build scripts, the generator of the model description and of the constants from the
-//!   contract TOML (`build`, feature "build").
+//!   contract TOML (`build`, feature "build"), and the variable tables of the documentation
+//!   ([`table`]).
 
 #[cfg(feature = "build")]
 pub mod build;
@@ -30,6 +31,7 @@ mod macros;
 pub mod slave;
 pub mod state;
 pub mod status;
+pub mod table;
 pub mod values;
 
 #[cfg(feature = "runtime")]

@@ -16,7 +16,6 @@ initialisation mode by themselves; the fmpy loop exchanges once before leaving i
 
 from __future__ import annotations
 
-import functools
 import math
 import pathlib
 
@@ -254,36 +253,6 @@ def run_ecos(t_end: float, h: float, gear_params: dict | None = None) -> dict:
 
 
 MASTERS = {"fmpy": run_fmpy, "libcosim": run_libcosim, "ecos": run_ecos}
-
-
-# ----------------------------------------------------------------------------------------
-# For the tests: the FMUs, and each run made once per session
-# ----------------------------------------------------------------------------------------
-
-
-def require_fmus():
-    """Both FMU paths; a missing FMU FAILS the test (never skips) with how to build it."""
-    import pytest
-
-    for path, how in ((GEAR_FMU, "make fmu"), (FLYWHEEL_FMU, "make flywheel-fmu")):
-        if not path.is_file():
-            pytest.fail(f"{path} does not exist: build it with `{how}` (or `make test`), then rerun", pytrace=False)
-    return GEAR_FMU, FLYWHEEL_FMU
-
-
-@functools.lru_cache(maxsize=None)
-def reference_for_tests() -> M.Result:
-    """The monolithic reference sampled at the test runs' communication points."""
-    n = int(round(T_TEST / H_TEST))
-    return M.simulate(T_TEST, np.arange(n + 1) * H_TEST)
-
-
-@functools.lru_cache(maxsize=None)
-def run_for_tests(master: str, inputs: str = "alpha") -> dict:
-    """The coupled test run (T_TEST, H_TEST) of a master; `inputs` for fmpy only."""
-    if master == "fmpy":
-        return run_fmpy(T_TEST, H_TEST, inputs=inputs)
-    return MASTERS[master](T_TEST, H_TEST)
 
 
 # ----------------------------------------------------------------------------------------

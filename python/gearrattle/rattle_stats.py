@@ -133,7 +133,7 @@ def values_at_impacts(events, values):
 
 
 # --------------------------------------------------------------------------- window summaries
-# (added for scripts/rattle_map.py; the functions above are unchanged)
+# (what the sampled engine, gearrattle.study.sampled, reports over its window)
 
 def mean_rate(t, y, t_from, t_to):
     """Mean rate of a cumulative output y (e.g. a dissipated energy) over [t_from, t_to]:

@@ -1,4 +1,4 @@
-//! The co-simulation slave: FMI 2.0's calls as methods on a typed instance, free of C types,
+//! An FMU instance of either interface: FMI 2.0's calls as typed methods, free of C types,
 //! for the shell ([`fmi2_shell::Slave`]). Each method returns `Ok(())` or an [`FmiError`]
 //! with its reason; the shell checks the state machine before calling in and turns the
 //! results into fmi2Status and log lines.
@@ -23,7 +23,7 @@ const STEPS: usize = contract::log::logStep;
 const _: () = assert!(contract::log::logStatusError == fmi2_shell::log::ERRORS);
 const _: () = assert!(contract::log::logStatusWarning == fmi2_shell::log::WARNINGS);
 
-/// One co-simulation instance. Everything but the logging settings and the queued lines is
+/// One FMU instance. Everything but the logging settings and the queued lines is
 /// its FMU state (fmi2GetFMUstate / fmi2SerializeFMUstate): parameters, inputs, time, the
 /// model's state, the integrator's step size and controller memory, counters, energies.
 #[derive(Clone, Debug, Serialize, Deserialize)]

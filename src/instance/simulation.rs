@@ -8,8 +8,8 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::{FmiError, FmiResult};
-use crate::contract::vr;
+use super::FmiResult;
+use crate::contract::{self, vr};
 use crate::integrator::{Jacobian, Method, Piecewise, Solver, SolverError, Stats};
 use crate::physics::{
     Dynamics, Excitation, GearParams, Loads, MainShaft, Polynomial, Region, Shaft, Sine, TorqueRamp,
@@ -172,39 +172,24 @@ pub fn gear_params(values: &Values) -> GearParams {
     }
 }
 
-/// The integration method the `solver` parameter asks for.
-fn method(values: &Values) -> FmiResult<Method> {
+/// The integration method the `solver` parameter asks for (checked against its range).
+fn method(values: &Values) -> Method {
     match values.integer(vr::solver) {
-        0 => Ok(Method::Auto),
-        1 => Ok(Method::Explicit),
-        2 => Ok(Method::Implicit),
-        other => Err(FmiError::error(format!(
-            "parameter solver = {other} is invalid: allowed 0 (auto), 1 (DOPRI5) or 2 (Radau IIA)"
-        ))),
-    }
-}
-
-/// Checks that a parameter outside the gear's nine is finite and within its range.
-fn check(name: &str, value: f64, ok: bool, allowed: &str) -> FmiResult {
-    if value.is_finite() && ok {
-        Ok(())
-    } else {
-        Err(FmiError::error(format!(
-            "parameter {name} = {value:e} is invalid: allowed {allowed}"
-        )))
+        0 => Method::Auto,
+        1 => Method::Explicit,
+        2 => Method::Implicit,
+        other => unreachable!("solver = {other} is outside the contract's range"),
     }
 }
 
 impl Simulation {
-    /// Validates the parameters and builds the initial state at t0 (MODEL.md §1:
+    /// Checks the parameters against the contract's ranges and builds the initial state at t0 (MODEL.md §1:
     /// ξ(0) = gap_start·G, ξ'(0) = xi_dot_start; in torque mode the shaft starts from the
     /// values of the inputs theta_M and omega_M, θ_M(0) = theta_M, ω_M(0) = omega_M, and
     /// τ_in ramps at `tau_in_rate`, the derivative fmi2SetRealInputDerivatives gave).
     pub fn new(values: &Values, tau_in_rate: f64, t0: f64, rtol: f64) -> FmiResult<Self> {
+        contract::check_parameters(values)?;
         let params = gear_params(values);
-        params
-            .validate()
-            .map_err(|e| FmiError::error(e.to_string()))?;
         let f_exc = param(values, vr::f_exc);
         let a_rms = param(values, vr::A_rms);
         let omega_mean = param(values, vr::omega_mean);
@@ -212,18 +197,6 @@ impl Simulation {
         let xi_dot_start = param(values, vr::xi_dot_start);
         let I_M = param(values, vr::I_M);
         let stats_from = param(values, vr::stats_from);
-        check("f_exc", f_exc, f_exc > 0.0, "finite and > 0")?;
-        check("A_rms", a_rms, true, "finite")?;
-        check("omega_mean", omega_mean, true, "finite")?;
-        check("gap_start", gap_start, true, "finite")?;
-        check("xi_dot_start", xi_dot_start, true, "finite")?;
-        check("I_M", I_M, I_M > 0.0, "finite and > 0")?;
-        check(
-            "stats_from",
-            stats_from,
-            stats_from >= 0.0,
-            "finite and >= 0",
-        )?;
         let shaft = Shaft {
             theta: param(values, vr::theta_M),
             omega: param(values, vr::omega_M),
@@ -236,13 +209,9 @@ impl Simulation {
                 tau: param(values, vr::tau_in),
                 rate: tau_in_rate,
             },
-            other => {
-                return Err(FmiError::error(format!(
-                    "parameter excitation = {other} is invalid: allowed 0 (inputs), 1 (sine) or 2 (torque)"
-                )));
-            }
+            other => unreachable!("excitation = {other} is outside the contract's range"),
         };
-        let method = method(values)?;
+        let method = method(values);
         let dynamics = Dynamics::new(params);
         let xi = gap_start * params.G;
         let gear = match drive {

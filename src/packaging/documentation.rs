@@ -1,7 +1,7 @@
 //! `documentation/index.html` inside the FMU: the equations of MODEL.md with the paper's
 //! numbers, and the parameter and variable tables generated from the contract.
 
-use crate::contract::{Causality, Start, VARIABLES};
+use crate::contract::{Causality, VARIABLES};
 
 const HEAD: &str = r#"<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8"><title>GearRattle</title>
@@ -90,30 +90,8 @@ ex.simulate_until(target_time=500_000_000)                      # 0.5 s</pre>
 /// The work-precision plot of `make bench` (docs/work_precision.png), shown on the page.
 pub const WORK_PRECISION_PNG: &[u8] = include_bytes!("../../docs/work_precision.png");
 
-fn start(s: &Start) -> String {
-    match s {
-        Start::Real(x) => format!("{x}"),
-        Start::Integer(i) => i.to_string(),
-        Start::None => String::new(),
-    }
-}
-
 fn table(title: &str, causality: Causality) -> String {
-    let mut html = format!(
-        "<h2>{title}</h2>\n<table><tr><th>name</th><th>value reference</th><th>type</th><th>start</th><th>unit</th><th>description</th></tr>\n"
-    );
-    for v in VARIABLES.iter().filter(|v| v.causality == causality) {
-        html += &format!(
-            "<tr><td><code>{}</code></td><td>{}</td><td>{:?}</td><td>{}</td><td>{}</td><td>{}</td></tr>\n",
-            v.name,
-            v.vr,
-            v.kind,
-            start(&v.start),
-            v.unit,
-            v.description.replace('<', "&lt;")
-        );
-    }
-    html + "</table>\n"
+    fmi2_shell::table::html(title, VARIABLES, causality)
 }
 
 /// The whole page.

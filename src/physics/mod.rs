@@ -22,5 +22,5 @@ pub use excitation::{Excitation, Polynomial, Shaft, Sine, TorqueRamp};
 pub use flight::{Flight, FlightStart, FlightState};
 pub use motion::{Dynamics, Loads, MainShaft};
 pub use oil::Oil;
-pub use params::{GearParams, ParamError};
+pub use params::GearParams;
 pub use series::ContactSeries;

@@ -1,5 +1,6 @@
 //! The nine parameters of the paper (MODEL.md §4) plus the external torque B and the
-//! carrier-shaft speed ω_S of the equation of motion (§3), with their validation.
+//! carrier-shaft speed ω_S of the equation of motion (§3). Their ranges are the contract's
+//! (modelDescription/GearRattle.toml), checked by the instance before it builds them.
 #![allow(non_snake_case)]
 
 use serde::{Deserialize, Serialize};
@@ -31,24 +32,6 @@ pub struct GearParams {
     pub omega_S: f64,
 }
 
-/// A parameter outside its allowed range.
-#[derive(Clone, Debug, PartialEq)]
-pub struct ParamError {
-    pub name: &'static str,
-    pub value: f64,
-    pub allowed: &'static str,
-}
-
-impl std::fmt::Display for ParamError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(
-            f,
-            "parameter {} = {:e} is invalid: allowed {}",
-            self.name, self.value, self.allowed
-        )
-    }
-}
-
 impl GearParams {
     /// The studied gearbox of the paper (§7), MODEL.md §4.
     pub fn paper() -> Self {
@@ -64,36 +47,6 @@ impl GearParams {
             C: 0.025,
             B: 0.0,
             omega_S: 0.0,
-        }
-    }
-
-    /// Checks every parameter; the first invalid one is reported.
-    pub fn validate(&self) -> Result<(), ParamError> {
-        let positive = "finite and > 0";
-        let non_negative = "finite and >= 0";
-        let checks: [(&'static str, f64, bool, &'static str); 11] = [
-            ("I_L", self.I_L, self.I_L > 0.0, positive),
-            ("r_L", self.r_L, self.r_L > 0.0, positive),
-            ("r_M", self.r_M, self.r_M > 0.0, positive),
-            ("K_star", self.K_star, self.K_star > 0.0, positive),
-            ("alpha", self.alpha, self.alpha >= 1.0, "finite and >= 1"),
-            ("epsilon", self.epsilon, self.epsilon >= 0.0, non_negative),
-            ("G", self.G, self.G > 0.0, positive),
-            ("C_LM", self.C_LM, self.C_LM >= 0.0, non_negative),
-            ("C", self.C, self.C >= 0.0, non_negative),
-            ("B", self.B, true, "finite"),
-            ("omega_S", self.omega_S, true, "finite"),
-        ];
-        match checks
-            .iter()
-            .find(|(_, value, ok, _)| !(value.is_finite() && *ok))
-        {
-            Some(&(name, value, _, allowed)) => Err(ParamError {
-                name,
-                value,
-                allowed,
-            }),
-            None => Ok(()),
         }
     }
 

@@ -7,15 +7,9 @@ import zipfile
 import numpy as np
 import pytest
 
-import masters as MS
-import monolithic as M
+from gearrattle import monolithic as M
 
 FW = M.FLYWHEEL
-
-
-@pytest.fixture(scope="module")
-def fmus():
-    return MS.require_fmus()
 
 
 def test_validates(fmus):

@@ -1,6 +1,6 @@
 """GearRattle coupled with its drivetrain partner (Flywheel) in three masters: fmpy (a
 hand-written Jacobi loop on FMU2Slave), libcosim and Ecos, over 0.5 s at 0.1 ms
-communication steps, against the monolithic reference (monolithic.py) and each other.
+communication steps, against the monolithic reference (gearrattle/monolithic.py) and each other.
 
 Tolerances, from the coupling study (docs/COUPLING.md, h = 0.1 ms): the Jacobi coupling
 holds tau_M over each step, an error of first order in h; pointwise agreement holds over the
@@ -11,22 +11,11 @@ few per cent."""
 import numpy as np
 import pytest
 
-import masters as MS
-import reference as R
+from gearrattle import masters as MS
+from gearrattle import monolithic as M
+from gearrattle import reference as R
 
 MASTERS = ("fmpy", "libcosim", "ecos")
-
-
-@pytest.fixture(scope="module")
-def reference():
-    return MS.reference_for_tests()
-
-
-@pytest.fixture(scope="module")
-def coupled_run():
-    MS.require_fmus()
-    return MS.run_for_tests
-
 G = R.DEFAULTS["G"]
 WINDOW = 0.1  # s: the pointwise comparison window
 
@@ -38,18 +27,18 @@ XI_WINDOW = 0.25 * G
 
 
 @pytest.mark.parametrize("master", MASTERS)
-def test_coupled_run_matches_monolithic_reference(coupled_run, reference, master):
+def test_coupled_run_matches_monolithic_reference(coupled_run, coupled_reference, master):
     rec = coupled_run(master)
     t = rec["time"]
-    np.testing.assert_allclose(t, reference.t, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(t, coupled_reference.t, rtol=0, atol=1e-9)
     # it rattles, on both flanks
     assert rec["impacts_Fplus"][-1] >= 10 and rec["impacts_Fminus"][-1] >= 10, (rec["impacts_Fplus"][-1], rec["impacts_Fminus"][-1])
-    c = MS.compare(rec, reference)
+    c = MS.compare(rec, coupled_reference)
     assert c["rate_rel"] <= RATE_REL, c
     assert c["omega_M"] <= OMEGA_RUN, c
     w = (t <= WINDOW + 1e-12) & np.isfinite(rec["xi"])
-    assert np.max(np.abs(rec["omega_M"][w] - reference.omega_M[w])) <= OMEGA_WINDOW
-    assert np.max(np.abs(rec["xi"][w] - reference.xi[w])) <= XI_WINDOW
+    assert np.max(np.abs(rec["omega_M"][w] - coupled_reference.omega_M[w])) <= OMEGA_WINDOW
+    assert np.max(np.abs(rec["xi"][w] - coupled_reference.xi[w])) <= XI_WINDOW
     # the shaft the gear pair saw is the Flywheel's: kinematics across the connection
     assert np.all(np.isfinite(rec["omega_M"][1:])) and np.all(np.diff(rec["theta_M"][1:]) > 0)
 
@@ -68,7 +57,7 @@ def test_masters_agree_with_each_other(coupled_run):
     assert d <= 1e-6, d
 
 
-def test_input_derivatives_in_fmpy(coupled_run, reference):
+def test_input_derivatives_in_fmpy(coupled_run, coupled_reference):
     """With GearRattle's canInterpolateInputs, the fmpy master passes the shaft's derivatives
     through fmi2SetRealInputDerivatives instead of connecting alpha_M: the same information,
     so the same run; passing also d tau_M / dt (GearRattle's fmi2GetRealOutputDerivatives)
@@ -82,22 +71,20 @@ def test_input_derivatives_in_fmpy(coupled_run, reference):
     if MS.max_output_derivative_order() < 1:
         pytest.skip("GearRattle gives no output derivatives: no d tau_M / dt for the Flywheel")
     both = coupled_run("fmpy", "derivatives+tau")
-    w = reference.t <= WINDOW + 1e-12
+    w = coupled_reference.t <= WINDOW + 1e-12
 
     def err(rec):
-        return np.max(np.abs(rec["omega_M"][w] - reference.omega_M[w]))
+        return np.max(np.abs(rec["omega_M"][w] - coupled_reference.omega_M[w]))
 
     assert err(both) <= 0.5 * err(alpha), (err(both), err(alpha))
-    c = MS.compare(both, reference)
+    c = MS.compare(both, coupled_reference)
     assert c["rate_rel"] <= RATE_REL and c["omega_M"] <= OMEGA_RUN, c
 
 
 def test_monolithic_reference_is_the_gear_reference_on_a_stiff_shaft():
-    """The monolithic reference takes its contact law from tests/python/reference.py: with a
+    """The monolithic reference takes its contact law from gearrattle/reference.py: with a
     main shaft of huge inertia and no engine torque (the shaft turns at idle speed, unmoved by
     the contact), it is reference.simulate with that imposed shaft."""
-    import monolithic as M
-
     pf = {**M.FLYWHEEL, "I_M": 1e12, "I_E": 1e12, "T_2": 0.0, "T_mean": 0.0}
     pg = M.gear_params(xi_dot_start=-0.05)
     t = np.linspace(0.0, 0.02, 201)

@@ -1,7 +1,7 @@
 """The drivetrain integrated monolithically through GearRattle's Model Exchange interface
 (gearrattle/model_exchange.py: the shaft, clutch damper and engine in Python around the FMU,
 one state vector, the FMU's event indicators as events), against the independent monolithic
-reference (monolithic.py) over 50 ms, ten impacts. Each solver: LSODA (nonstiff over these
+reference (gearrattle/monolithic.py) over 50 ms, ten impacts. Each solver: LSODA (nonstiff over these
 50 ms, no Jacobian), Radau and BDF (their Newton iterations on the master's exact Jacobian).
 
 Bounds: at rtol 1e-10 the runs differ from the reference by at most about 5e-7 G in ξ (BDF;
@@ -13,7 +13,6 @@ steps."""
 import numpy as np
 import pytest
 
-from gearrattle import masters as MS
 from gearrattle import model_exchange as ME
 from gearrattle import monolithic as M
 from gearrattle import reference as R
@@ -23,8 +22,7 @@ T_END, DT = 0.05, 1e-5
 
 
 @pytest.fixture(scope="module", params=sorted(ME.SOLVERS))
-def run(request):
-    MS.require_fmus()
+def run(request, fmus):
     return ME.simulate(T_END, DT, rtol=1e-10, method=request.param)
 
 

@@ -6,7 +6,6 @@ master's own right-hand side, at states in each region of the contact law."""
 import numpy as np
 import pytest
 
-from gearrattle import masters as MS
 from gearrattle import model_exchange as ME
 from gearrattle import reference as R
 
@@ -22,8 +21,7 @@ OMEGA_L = 1  # omega_L's place among the FMU's states (docs/MODEL_EXCHANGE.md)
 
 
 @pytest.fixture(scope="module")
-def drivetrain():
-    MS.require_fmus()
+def drivetrain(fmus):
     with ME.Drivetrain() as dt_:
         yield dt_
 

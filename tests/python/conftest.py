@@ -3,29 +3,10 @@
 The FMU tests need target/fmu/GearRattle.fmu: when it is missing they FAIL (never skip)
 with a message telling how to build it, so that a missing build cannot pass silently."""
 
-import pathlib
-import tomllib
-
-import numpy as np
 import pytest
 
 from gearrattle import reference as R
-
-HERE = pathlib.Path(__file__).resolve().parent
-ROOT = HERE.parents[1]
-FMU_PATH = ROOT / "target" / "fmu" / "GearRattle.fmu"
-CONTRACT_PATH = ROOT / "modelDescription" / "GearRattle.toml"
-
-
-
-def contract_outputs() -> list:
-    """Every output of the contract, in its order: the FMU runs record them all, so an output
-    added to modelDescription/GearRattle.toml is recorded without an edit here."""
-    with open(CONTRACT_PATH, "rb") as f:
-        return [v["name"] for v in tomllib.load(f)["variable"] if v["causality"] == "output"]
-
-
-OUTPUTS = contract_outputs()
+from support.fmu import FMU_PATH, OUTPUTS, main_shaft_input
 
 
 @pytest.fixture(scope="session")
@@ -83,20 +64,6 @@ def slave(unzipdir, model_description, vrs):
     yield make
     for fmu in made:
         fmu.freeInstance()
-
-
-def main_shaft_input(scene: str, t_end: float, dt: float = 1e-4, fields=("theta_M", "omega_M", "alpha_M"), **overrides):
-    """Structured input array for fmpy: the analytic sine motion of the main shaft (§5)."""
-    p = R.params(scene, **overrides)
-    n = int(round(t_end / dt))
-    t = np.arange(n + 1) * dt
-    th, om, al = R.main_shaft(t, p)
-    values = {"theta_M": th, "omega_M": om, "alpha_M": al}
-    sig = np.zeros(t.size, dtype=[("time", np.float64)] + [(f, np.float64) for f in fields])
-    sig["time"] = t
-    for f in fields:
-        sig[f] = values[f]
-    return sig
 
 
 @pytest.fixture(scope="session")

@@ -1,8 +1,8 @@
-"""Input derivatives, output derivatives and directional derivatives (issue 5), checked
+"""Input derivatives, output derivatives and directional derivatives, checked
 against finite differences and against the same motion given as plain inputs."""
 
 import numpy as np
-import reference as R
+from gearrattle import reference as R
 
 
 def shaft(t):

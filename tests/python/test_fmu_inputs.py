@@ -5,7 +5,7 @@ the step (MODEL.md §5, drivetrain coupling)."""
 import numpy as np
 import pytest
 
-import reference as R
+from gearrattle import reference as R
 
 P = R.params()
 G = P["G"]

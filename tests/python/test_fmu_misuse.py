@@ -27,7 +27,7 @@ from fmpy.fmi2 import (
     fmi2Integer,
 )
 
-import reference as R
+from gearrattle import reference as R
 
 REFUSED = (fmi2Discard, fmi2Error)  # a refused call: not OK, not Warning, never Fatal
 UNKNOWN_VR = 999
@@ -333,6 +333,47 @@ def test_invalid_parameter_refused(slave, name, value):
     assert slave.real(name) == pytest.approx(R.DEFAULTS[name], rel=1e-15)
     assert slave.do_step(1e-3) == fmi2OK
     assert slave.real("xi") == pytest.approx(0.5 * R.DEFAULTS["G"], abs=1e-15)
+
+
+def _ranged_parameters(fmu_path):
+    """(name, type, bound, exclusive, side) of every bound the model description states, read
+    as the study runner reads it (gearrattle.study.model)."""
+    from gearrattle.study.model import read_model
+
+    for v in read_model(fmu_path).parameters.values():
+        if v.min is not None:
+            yield v.name, v.type, v.min, v.min_exclusive, -1
+        if v.max is not None:
+            yield v.name, v.type, v.max, v.max_exclusive, +1
+
+
+def test_the_fmu_enforces_every_range_its_model_description_states(unzipdir, model_description,
+                                                                  fmu_path):
+    """Each stated bound: a value beyond it (at it, for an exclusive one) is refused at the
+    latest by exitInitializationMode with a message naming the parameter and its range, and
+    an inclusive bound itself is accepted."""
+    bounds = list(_ranged_parameters(fmu_path))
+    assert {"I_L", "G", "alpha", "excitation"} <= {b[0] for b in bounds}, bounds
+    for name, kind, bound, exclusive, side in bounds:
+        step = 1 if kind == "Integer" else max(abs(bound), 1.0) * 1e-9
+        for value, accepted in ([(bound, False)] if exclusive else
+                                [(bound + side * step, False), (bound, True)]):
+            s = Slave(unzipdir, model_description, "ranges")
+            try:
+                assert s.setup() == fmi2OK and s.enter_init() == fmi2OK
+                m = s.mark()
+                if kind == "Integer":
+                    assert s.set_integer([s.vrs[name]], [int(value)]) == fmi2OK
+                else:
+                    assert s.set_real([s.vrs[name]], [value]) == fmi2OK
+                status = s.exit_init()
+                if accepted:
+                    assert status == fmi2OK, (name, value, s.new_logs(m))
+                else:
+                    assert status in REFUSED, f"{name} = {value} accepted"
+                    s.assert_logged(m, name, "is invalid: allowed")
+            finally:
+                s.free()
 
 
 @pytest.mark.parametrize(

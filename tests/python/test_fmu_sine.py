@@ -8,8 +8,8 @@ import tomllib
 import numpy as np
 import pytest
 
-import reference as R
-from conftest import CONTRACT_PATH
+from gearrattle import reference as R
+from support.fmu import CONTRACT_PATH
 
 P = R.params()
 G = P["G"]

@@ -1,12 +1,12 @@
-"""The `solver` parameter and the `solver_method` output (issue 4): each method against the
-independent reference (tests/python/reference.py), and the automatic hand-over to Radau IIA
+"""The `solver` parameter and the `solver_method` output: each method against the
+independent reference (gearrattle/reference.py), and the automatic hand-over to Radau IIA
 on a stiff gear pair, which must give the explicit method's answer for far fewer right-hand
 sides (counted by the FMU: deterministic, not a timing)."""
 
 import numpy as np
 import pytest
 
-import reference as R
+from gearrattle import reference as R
 
 AUTO, EXPLICIT, IMPLICIT = 0, 1, 2
 DOPRI5, RADAU = 1, 2
@@ -48,7 +48,7 @@ def test_auto_hands_over_on_a_tiny_idler(fmu_run):
 
 
 def test_sine_cost_does_not_depend_on_the_communication_step(fmu_run):
-    """Issue 3: in sine mode communication points are served from the dense output of natural
+    """In sine mode communication points are served from the dense output of natural
     steps, so 10 µs communication steps cost the right-hand sides of 10 ms ones (counted by the
     FMU), and their values agree with the reference at every point."""
     t_end = 0.05

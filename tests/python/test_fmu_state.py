@@ -1,4 +1,4 @@
-"""FMU state (issue 5): rollback and re-step is bit-identical, a serialized state restores
+"""FMU state: rollback and re-step is bit-identical, a serialized state restores
 bit-identically into a second instance, and corrupt or foreign bytes are refused without
 harm to the instance."""
 

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from fmpy import simulate_fmu
 
-import reference as R
+from gearrattle import reference as R
 import window_reference as W
 
 COUNTS = [f"stat_{k}_{f}" for k in ("impacts", "runs", "run_max") for f in ("Fplus", "Fminus")]

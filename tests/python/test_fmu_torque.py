@@ -1,4 +1,4 @@
-"""The FMU in torque mode (excitation = 2, issue 5): the main shaft is an inertia I_M driven by
+"""The FMU in torque mode (excitation = 2): the main shaft is an inertia I_M driven by
 the master's torque tau_in and pushed back by the contact, I_M omega_M' = tau_in + r_M F; the
 FMU outputs the shaft's motion (theta_M_out, omega_M_out, alpha_M_out) for a master that
 couples by torque. Checked against reference.simulate_torque (scipy, from the equations in
@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from fmpy.fmi2 import FMU2Slave, fmi2OK
 
-import reference as R
+from gearrattle import reference as R
 from test_fmu_misuse import REFUSED, Slave
 
 P = R.params()

@@ -9,7 +9,7 @@ import pytest
 from fmpy import simulate_fmu
 from fmpy.fmi2 import FMU2Model, fmi2Error, fmi2EventInfo, fmi2OK
 
-import reference as R
+from gearrattle import reference as R
 
 G = R.DEFAULTS["G"]
 
@@ -62,7 +62,7 @@ def test_model_exchange_and_co_simulation_agree(unzipdir, model_description, fmu
 def test_inputs_mode_by_input_signals(unzipdir, model_description):
     """The kinematic mode driven by fmpy input signals (θ_M, ω_M of S1's sine every 10 µs):
     the impacts of the reference over 0.2 s."""
-    from conftest import main_shaft_input
+    from support.fmu import main_shaft_input
     inp = main_shaft_input("S1", 0.2, 1e-5, ("theta_M", "omega_M"))
     res = simulate_fmu(unzipdir, model_description=model_description, fmi_type="ModelExchange",
                        solver="CVode", stop_time=0.2, output_interval=1e-5, relative_tolerance=1e-9,

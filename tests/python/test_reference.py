@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
-import reference as R
+from gearrattle import reference as R
 
 P = R.params()
 G = P["G"]

@@ -1,12 +1,12 @@
-"""Stress suite of issue 4: one test per case of stress_cases.CASES, run on the built FMU.
+"""The stress suite: one test per case of gearrattle.stress.CASES, run on the built FMU.
 
-Each test runs its case through fmpy (stress_cases.Driver) and judges it
-(stress_cases.evaluate): no NaN/Inf in any output; the error against the independent
-reference (reference.py) within 10 × the requested tolerance over the case's window, or the
-invariant (energy balance, no drift over an hour). Each case is "solved" or "gave up" (a
-refused fmi2DoStep): giving up fails every case but the one whose right answer is a refusal
-(it says why), and there the refusal must be clean (fmi2Discard/fmi2Error, a log line saying
-what happened and when, fmi2GetReal still giving the last good state).
+Each test runs its case through fmpy (stress.Driver) and judges it (stress.evaluate): no
+NaN/Inf in any output; the error against the independent reference (reference.py) within
+10 × the requested tolerance over the case's window, or the invariant (energy balance, no
+drift over an hour). Each case is "solved" or "gave up" (a refused fmi2DoStep): giving up
+fails every case but the one whose right answer is a refusal (it says why), and there the
+refusal must be clean (fmi2Discard/fmi2Error, a log line saying what happened and when,
+fmi2GetReal still giving the last good state).
 
 Steps, RHS evaluations, CPU and wall time in fmi2DoStep, and the error of every case are
 attached to the test (record_property, for --junitxml) and written to
@@ -18,7 +18,7 @@ import math
 
 import pytest
 
-import stress_cases as S
+from gearrattle import stress as S
 
 
 @pytest.fixture(scope="session")

@@ -12,7 +12,7 @@ import threading
 import numpy as np
 from fmpy.fmi2 import FMU2Slave, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
 
-from conftest import OUTPUTS
+from support.fmu import OUTPUTS
 
 INSTANCES = 8
 H = 1e-4

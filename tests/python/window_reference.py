@@ -10,7 +10,7 @@ by linear interpolation.
 import numpy as np
 from scipy.integrate import simpson
 
-import reference as R
+from gearrattle import reference as R
 
 
 def _flank_stats(times, flanks, speeds, t0, t1, m_eq):

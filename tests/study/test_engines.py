@@ -8,8 +8,7 @@ import subprocess
 import time
 
 from gearrattle.study.engine import batches
-from study_support import (STUDY, assert_same_rows, cluster, fmu, rows,  # noqa: F401
-                           study)
+from support.study import STUDY, assert_same_rows, rows, study
 
 # A small map in sine mode: 4 x 3 points of 0.3 s (statistics from 0.15 s, half the duration).
 SMALL = ["map", "--x", "f_exc=30:60:4", "--y", "A_rms=100:500:3", "--duration", "0.3",
@@ -83,11 +82,33 @@ def test_interrupted_study_resumes_without_recomputing(fmu, tmp_path):
     assert len(_partials(out)) > kept
 
 
+def _without_range(fmu, name, path):
+    """A copy of the FMU whose model description states no range for `name` (neither min nor
+    the description's statement): the study's checks let any value of it through, and the
+    FMU's own check refuses the invalid ones."""
+    import xml.etree.ElementTree as ET
+    import zipfile
+
+    with zipfile.ZipFile(fmu) as src, zipfile.ZipFile(path, "w") as dst:
+        for item in src.infolist():
+            data = src.read(item)
+            if item.filename == "modelDescription.xml":
+                root = ET.fromstring(data)
+                v = root.find(f"ModelVariables/ScalarVariable[@name='{name}']")
+                v.set("description", v.get("description").split(" (range: ")[0])
+                v[0].attrib.pop("min")
+                data = ET.tostring(root, encoding="utf-8", xml_declaration=True)
+            dst.writestr(item, data)
+    return str(path)
+
+
 def test_refused_points_are_rows_with_the_fmu_message(fmu, tmp_path):
-    """G <= 0 passes the study's checks (the FMU declares no minimum) and the FMU refuses it:
-    the point is a row with status refused and the FMU's message, the others are computed."""
+    """G <= 0 passes the study's checks of an FMU that states no range for G, and the FMU
+    refuses it: the point is a row with status refused and the FMU's message, the others are
+    computed."""
     out = str(tmp_path / "doe")
-    study("doe", "--fmu", fmu, "--out", out, "--workers", "0", "--param", "G=-1e-5:5e-5",
+    bare = _without_range(fmu, "G", tmp_path / "bare.fmu")
+    study("doe", "--fmu", bare, "--out", out, "--workers", "0", "--param", "G=-1e-5:5e-5",
           "--design", "full", "--n", "4", "--duration", "0.2")
     t = rows(out).to_pylist()
     assert [r["status"] for r in t] == ["refused", "ok", "ok", "ok"]

@@ -8,7 +8,6 @@ import pytest
 
 from gearrattle.study import worker
 from gearrattle.study.model import read_model
-from study_support import fmu  # noqa: F401 (fixture)
 
 POINT = {"excitation": 1, "f_exc": 42.0, "A_rms": 350.0, "G": 27e-6}
 OTHERS = [{"excitation": 1, "f_exc": 60.0, "A_rms": 700.0},

@@ -6,7 +6,7 @@ import os
 import pytest
 
 from gearrattle.study import cli, spec
-from study_support import fmu  # noqa: F401 (fixture)
+from gearrattle.study.errors import StudyError
 
 GOOD = """\
 kind = "mc"
@@ -71,10 +71,18 @@ def test_good_study_file_runs(fmu, tmp_path):
                                                            "LO < HI"]),
     (["mc", "--dist", "g=normal:2e-5:1e-6", "--n", "4"], ["'g'", "did you mean G"]),
     (["map", "--set", "solver=7"], ["solver = 7", "maximum 2"]),
+    (["map", "--set", "I_L=0"], ["--set I_L=0", "I_L = 0 kg.m2", "exclusive minimum 0",
+                                 "keep I_L within its range I_L > 0"]),
+    (["doe", "--param", "G=-1e-5:5e-5", "--n", "4"], ["--param G=-1e-5:5e-5", "G = -1e-05 m",
+                                                       "keep G within its range G > 0"]),
+    (["mc", "--dist", "K_star=uniform:0:3e6", "--n", "4"], ["K_star = 0", "K_star > 0"]),
+    (["map", "--set", "alpha=0.99"], ["alpha = 0.99", "minimum 1", "alpha >= 1"]),
     (["mc", "--dist", "G=uniform:2e-5:3e-5", "--n", "4", "--set", "f_exc=30", "--at",
       "f_exc=40"], ["--at f_exc=40", "also set or varied", "remove one"]),
 ], ids=["map empty range", "doe empty range", "mc negative width", "unknown name",
-        "above maximum", "set and operating point"])
+        "above maximum", "at an exclusive minimum", "range across an exclusive minimum",
+        "support at an exclusive minimum", "below an inclusive minimum",
+        "set and operating point"])
 def test_bad_flags_are_refused_before_running(args, words, fmu, tmp_path, capsys):
     out = tmp_path / "results"
     assert cli.main([*args, "--fmu", fmu, "--out", str(out)]) == 2
@@ -96,7 +104,7 @@ def test_stats_from_on_an_fmu_without_it_is_refused(fmu):
                                                    if k != "stats_from"})
     st = spec.Study(kind="map", fmu=fmu, out="unused", stats_from=(0.3, "--stats-from 0.3"))
     st.axes = [spec.parse_axis("f_exc=30:60:2", "--x"), spec.parse_axis("A_rms=100:700:2", "--y")]
-    with pytest.raises(spec.StudyError, match=r"--stats-from 0.3: this FMU has no parameter "
+    with pytest.raises(StudyError, match=r"--stats-from 0.3: this FMU has no parameter "
                                               r"stats_from.*make fmu"):
         spec.validate(st, older)
 
@@ -110,3 +118,33 @@ def test_empty_range_in_a_doe_file_is_refused(fmu, tmp_path, capsys):
     err = capsys.readouterr().err
     assert "line 6" in err and "empty range C" in err and "LO < HI" in err, err
     assert not os.path.exists(out)
+
+
+def test_values_at_inclusive_bounds_and_just_inside_exclusive_ones_pass(fmu):
+    """The bounds the study checks are the FMU's: alpha = 1 and C = 0 are allowed, and so is
+    the smallest positive I_L (I_L > 0 admits every positive double)."""
+    from gearrattle.study.model import read_model
+
+    st = spec.Study(kind="map", fmu=fmu, out="unused")
+    st.axes = [spec.parse_axis("f_exc=30:60:2", "--x"), spec.parse_axis("A_rms=100:700:2", "--y")]
+    st.fixed = {"alpha": (1.0, "--set"), "C": (0.0, "--set"), "I_L": (5e-324, "--set")}
+    spec.validate(st, read_model(fmu))
+
+
+@pytest.mark.parametrize("name, description, xml, want", [
+    ("T_oil", "Oil temperature (range: T_oil > -95)", (-94.99999999999999, None),
+     (-95.0, True, None, False)),
+    ("n_gears", "Number of loose gears (range: 1 <= n_gears <= 8)", (1.0, 8.0),
+     (1.0, False, 8.0, False)),
+    ("gear[3].I_L", "Moment of inertia (range: gear[3].I_L > 0)", (5e-324, None),
+     (0.0, True, None, False)),
+    ("x", "An upper bound only (range: x < 1e-6)", (None, 9.999999999999999e-07),
+     (None, False, 1e-6, True)),
+    # No statement, or one about another name: the XML's min and max, inclusive.
+    ("C", "Viscous drag", (0.0, None), (0.0, False, None, False)),
+    ("C", "Viscous drag (range: G > 0)", (0.0, None), (0.0, False, None, False)),
+])
+def test_ranges_are_read_from_the_description_statement(name, description, xml, want):
+    from gearrattle.study.model import _range
+
+    assert _range(name, description, *xml) == want

@@ -4,6 +4,7 @@
     gearrattle-study doe --fmu FMU --param NAME=LO:HI [...] --design lhs|full --n N --out DIR
     gearrattle-study mc  --fmu FMU --dist NAME=normal:MEAN:SD [...] --n N --seed S --out DIR
     gearrattle-study run STUDY.toml
+    gearrattle-study listen --fmu FMU --duration S --out DIR   (the rattle as sound: docs/SOUND.md)
 
 Results: DIR/points.parquet and DIR/points.csv (one row per point), a summary and figures."""
 
@@ -13,7 +14,8 @@ import sys
 import time
 
 from . import spec
-from .spec import StudyError
+from .errors import StudyError
+from ..sound import listen
 
 DEFAULT_FMU = os.path.join("target", "fmu", "GearRattle.fmu")
 
@@ -36,6 +38,9 @@ def _common(p, toml=False):
     p.add_argument("--record", action="append", default=[], metavar="OUTPUT",
                    help="also record this output at the end of each point (repeatable)")
     p.add_argument("--quiet", action="store_true", help="no progress bar, no summary")
+    p.add_argument("--sound", action="store_true",
+                   help="also the sound of each point: sound_N5, sound_sharpness, sound_LA "
+                        "(docs/SOUND.md; about 2 s of CPU per simulated second)")
 
 
 def parser():
@@ -74,6 +79,7 @@ def parser():
     r = sub.add_parser("run", help="a study described by a TOML file (docs/STUDIES.md)")
     r.add_argument("study", help="STUDY.toml")
     _common(r, toml=True)
+    listen.add_parser(sub)
     return ap
 
 
@@ -88,9 +94,10 @@ def from_args(a):
         if a.stats_from is not None:
             st.stats_from = (a.stats_from, f"--stats-from {a.stats_from:g}")
         st.record += a.record
+        st.sound = st.sound or a.sound
         return st
     st = spec.Study(kind=a.kind, fmu=a.fmu, out=a.out, duration=a.duration, workers=a.workers,
-                    scheduler=a.scheduler, record=list(a.record))
+                    scheduler=a.scheduler, record=list(a.record), sound=a.sound)
     for text in a.set:
         name, value = spec.parse_set(text, f"--set {text}")
         st.fixed[name] = (value, f"--set {text}")
@@ -126,6 +133,8 @@ def prepare(st):
 
 def main(argv=None):
     a = parser().parse_args(argv)
+    if a.kind == "listen":
+        return listen.main(a)
     try:
         st = from_args(a)
         model, data = prepare(st)

@@ -7,6 +7,8 @@ Monte Carlo, Saltelli's Sobol' sampling and Morris' trajectories share one defin
 import math
 from dataclasses import dataclass
 
+from .errors import StudyError
+
 FORMS = {
     "normal": ("MEAN", "SD"),
     "uniform": ("LO", "HI"),
@@ -56,8 +58,6 @@ U_EDGE = 1e-12  # uniform numbers are kept within [U_EDGE, 1 - U_EDGE]: finite q
 
 
 def parse_dist(text, where):
-    from .spec import StudyError
-
     name, sep, rest = text.partition("=")
     parts = rest.split(":")
     kind = parts[0].strip().lower()

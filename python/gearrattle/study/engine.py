@@ -37,12 +37,13 @@ class Plan:
         self.values = [{**p, **fixed} for p in varied]
         names = list(varied[0]) if varied else []
         self.param_names = names + [n for n in fixed if n not in names]
-        self.ids = [results.point_id(v, model.guid, st.duration) for v in self.values]
-        self.schema = results.schema(self.param_names, model, st.record)
+        self.ids = [results.point_id(v, model.guid, st.duration, st.sound) for v in self.values]
+        self.schema = results.schema(self.param_names, model, st.record, st.sound)
 
     def batch(self, points):
         """The points [(index, id, values)] as one batch of this study."""
-        return Batch(self.model.guid, self.st.duration, self.st.record, self.schema, points)
+        return Batch(self.model.guid, self.st.duration, self.st.record, self.schema, points,
+                     self.st.sound)
 
 
 def batch_size(n_points, n_workers):

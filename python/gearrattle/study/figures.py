@@ -5,7 +5,7 @@ import os
 
 import numpy as np
 
-from .report import column, ok_rows
+from .table import column, ok_rows
 
 COLS = 4
 

@@ -10,7 +10,7 @@ import numpy as np
 
 from . import designs
 from .figures import panels, save
-from .report import column, ok_rows
+from .table import column, ok_rows
 
 PERCENTILES = (1, 5, 25, 50, 75, 95, 99)
 CONFIDENCE = 0.95

@@ -6,6 +6,9 @@ import os
 
 import numpy as np
 
+from . import figures, montecarlo
+from .table import column, ok_rows
+from ..sound.study import COLUMNS, COST
 
 # The metrics drawn in the overview figures (all of them are in points.csv): where a user of a
 # rattle map looks first. An FMU without them gets its first metrics drawn.
@@ -19,18 +22,8 @@ def figure_metrics(metrics, record):
     return (drawn or [m for m in metrics if m not in record][:len(FIGURE_METRICS)]) + list(record)
 
 
-def ok_rows(table):
-    return np.asarray(table.column("status").to_pylist()) == "ok"
-
-
-def column(table, name):
-    return np.asarray(table.column(name).to_numpy(zero_copy_only=False), dtype=float)
-
-
 def write(st, model, table, wall):
     """Summary lines and the list of files written."""
-    from . import figures, montecarlo
-
     n = table.num_rows
     ok = ok_rows(table)
     cpu = column(table, "cpu_s")
@@ -48,7 +41,11 @@ def write(st, model, table, wall):
     for code, msg in sorted({(s, m) for s, m in zip(status, table.column("message").to_pylist())
                              if s != "ok"})[:10]:
         lines.append(f"  {code}: {msg}")
-    metrics = [v.name for v in model.metrics] + list(st.record)
+    if st.sound and np.isfinite(column(table, COST)).any():
+        lines.append(f"  sound: CPU per point median {np.nanmedian(column(table, COST)):.2f} s "
+                     f"(fine stepping, filtering and metrics) of {np.nanmedian(cpu):.2f} s")
+    extra = list(st.record) + (list(COLUMNS) if st.sound else [])
+    metrics = [v.name for v in model.metrics] + extra
     if not metrics:
         lines.append("  this FMU has no stat_* outputs: the rows hold the parameters and status")
     elif ok.any():
@@ -58,7 +55,7 @@ def write(st, model, table, wall):
             x = x[np.isfinite(x)]
             lines.append(f"  {m:24s} " + (f"{x.min():11.4g} {np.median(x):11.4g} {x.max():11.4g}"
                                           if len(x) else "undefined at every point"))
-    drawn = figure_metrics(metrics, st.record)
+    drawn = figure_metrics(metrics, extra)
     if st.kind == "map" and metrics:
         files += figures.map_figures(st, table, drawn)
     elif st.kind == "doe" and metrics:

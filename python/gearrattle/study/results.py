@@ -14,9 +14,12 @@ import uuid
 STATUS_COLUMNS = ["status", "message", "cpu_s", "guid"]
 
 
-def point_id(values, guid, duration):
-    """Hex digest of the point's identity. values includes stats_from when the FMU has it."""
+def point_id(values, guid, duration, sound=False):
+    """Hex digest of the point's identity. values includes stats_from when the FMU has it; a
+    point with the sound columns is another point than the same without."""
     key = [guid, float(duration).hex(), sorted((k, float(v).hex()) for k, v in values.items())]
+    if sound:
+        key.append("sound")
     return hashlib.sha256(json.dumps(key).encode()).hexdigest()[:24]
 
 
@@ -63,9 +66,11 @@ class Store:
         return table
 
 
-def schema(param_names, model, record):
+def schema(param_names, model, record, sound=False):
     """Columns: point, the parameters (FMU names), duration, the metrics (stat_*), the recorded
-    outputs, status, message, cpu_s, guid, point_id."""
+    outputs, the sound columns (with --sound), status, message, cpu_s, guid, point_id."""
+    from ..sound.study import COLUMNS, COST
+
     import pyarrow as pa
 
     def arrow(var):
@@ -76,6 +81,7 @@ def schema(param_names, model, record):
     fields += [pa.field("duration", pa.float64())]
     fields += [pa.field(v.name, arrow(v)) for v in model.metrics]
     fields += [pa.field(n, arrow(model.outputs[n])) for n in record]
+    fields += [pa.field(n, pa.float64()) for n in (*COLUMNS, COST)] if sound else []
     fields += [pa.field("status", pa.string()), pa.field("message", pa.string()),
                pa.field("cpu_s", pa.float64()), pa.field("guid", pa.string()),
                pa.field("point_id", pa.string())]

@@ -1,5 +1,5 @@
-"""The rattle map's engine before the study runner: fmpy's simulate_fmu records the outputs every
-`interval` (50 us) and the statistics are computed from those samples (gearrattle.rattle_stats).
+"""The sampled engine: fmpy's simulate_fmu records the outputs every `interval` (50 us) and the
+statistics are computed from those samples (gearrattle.rattle_stats), not read from stat_*.
 The benchmark's baseline, and what `make rattle-map --trajectory-stats` uses for the statistics
 that need the trajectory itself (free flights, impact speeds along a run, gaps between
 impacts), which no stat_* output carries."""

@@ -12,6 +12,7 @@ import tomllib
 from dataclasses import dataclass, field
 
 from .distributions import Dist, parse_dist
+from .errors import StudyError
 from .model import METRIC_PREFIX, STATS_FROM
 
 KINDS = ("map", "doe", "mc")
@@ -22,10 +23,6 @@ DEFAULT_STATS_FROM = 0.2
 # The studies run the FMU alone, with no master feeding its inputs: the paper's sine bench
 # (excitation = 1) unless the study sets another mode.
 STANDALONE = {"excitation": 1}
-
-
-class StudyError(Exception):
-    """A study refused before anything runs; the message names the place and the fix."""
 
 
 @dataclass
@@ -87,6 +84,7 @@ class Study:
     exceed: list = field(default_factory=list)  # mc: [Exceed]
     sensitivity: str = "none"
     record: list = field(default_factory=list)  # outputs recorded besides the stat_* ones
+    sound: bool = False  # the sound columns of each point (gearrattle.sound.study)
     source: str = "command line"
 
     def varied(self):
@@ -305,14 +303,21 @@ def _check_name(name, where, model, varied):
 
 
 def _check_bounds(name, lo, hi, where, model, what):
+    """Refuse values of name from lo to hi that leave the FMU's range (exclusive bounds
+    included: I_L = 0 against I_L > 0), naming the range and the fix."""
     v = model.parameters[name]
     unit = f" {v.unit}" if v.unit else ""
-    if v.min is not None and lo < v.min:
-        raise StudyError(f"{where}: {what} {name} = {lo:g}{unit} is below the FMU's minimum "
-                         f"{v.min:g}: keep {name} within {v.min:g}..{v.max if v.max is not None else 'inf'}")
-    if v.max is not None and hi > v.max:
-        raise StudyError(f"{where}: {what} {name} = {hi:g}{unit} is above the FMU's maximum "
-                         f"{v.max:g}: keep {name} within {v.min if v.min is not None else '-inf'}..{v.max:g}")
+    fix = f"keep {name} within its range {v.statement()}"
+    if math.isnan(lo) or math.isnan(hi):
+        raise StudyError(f"{where}: {what} {name} is not a number: {fix}")
+    if v.below(lo):
+        side = ("not above the FMU's exclusive minimum" if v.min_exclusive
+                else "below the FMU's minimum")
+        raise StudyError(f"{where}: {what} {name} = {lo:g}{unit} is {side} {v.min:g}: {fix}")
+    if v.above(hi):
+        side = ("not below the FMU's exclusive maximum" if v.max_exclusive
+                else "above the FMU's maximum")
+        raise StudyError(f"{where}: {what} {name} = {hi:g}{unit} is {side} {v.max:g}: {fix}")
 
 
 def validate(st, model):

@@ -19,7 +19,7 @@ import zipfile
 
 from distributed.diagnostics.plugin import WorkerPlugin
 
-from .model import read_model
+from .model import STATS_FROM, read_model
 
 _FMUS = {}  # GUID -> (extracted directory, Model), per process
 _LOCK = threading.Lock()
@@ -88,7 +88,7 @@ class Instance:
         from fmpy.fmi2 import (FMU2Slave, fmi2CallbackAllocateMemoryTYPE,
                                fmi2CallbackFreeMemoryTYPE)
 
-        self.model = model
+        self.model, self.unzipdir = model, unzipdir
         self.name = f"study{os.getpid()}_{next(_NAMES)}"
         self.logs = _LOGS.setdefault(self.name, [])
         self.callbacks = _route_messages()  # its logger becomes the formatting proxy
@@ -105,9 +105,9 @@ class Instance:
         self.fmu.freeInstance()
         _LOGS.pop(self.name, None)
 
-    def run(self, values, duration, record=()):
+    def run(self, values, duration, record=(), sound=False):
         """Run one point: values = {parameter name: value}. Returns a dict of the metrics (and
-        the recorded outputs), status, message and cpu_s."""
+        the recorded outputs, the sound columns), status, message and cpu_s."""
         from fmpy.fmi1 import FMICallException
 
         t0 = time.process_time()
@@ -127,7 +127,13 @@ class Instance:
             call = "fmi2ExitInitializationMode"
             self.fmu.exitInitializationMode()
             call = "fmi2DoStep"
-            self.fmu.doStep(0.0, duration)
+            if sound:
+                from ..sound.study import point
+
+                row.update(point(self.fmu, self.unzipdir, values, duration,
+                                 values.get(STATS_FROM, 0.0)))
+            else:
+                self.fmu.doStep(0.0, duration)
             call = "fmi2Get*"
             row.update(self._get(self.metric_real, self.metric_int))
             if record:
@@ -209,11 +215,11 @@ class Batch:
     """A batch of points [(point index, point id, {name: value})] with what its rows need: one
     opaque task argument, so that Dask does not walk through its points looking for futures."""
 
-    __slots__ = ("guid", "duration", "record", "schema", "points")
+    __slots__ = ("guid", "duration", "record", "schema", "points", "sound")
 
-    def __init__(self, guid, duration, record, schema, points):
+    def __init__(self, guid, duration, record, schema, points, sound=False):
         self.guid, self.duration, self.record = guid, duration, tuple(record)
-        self.schema, self.points = schema, points
+        self.schema, self.points, self.sound = schema, points, sound
 
     def table(self, rows):
         """The points' result rows (metrics and status, in order) completed with each point's
@@ -232,7 +238,7 @@ def run_batch(batch):
     rows = []
     for _, _, values in batch.points:
         try:
-            row = instance(batch.guid).run(values, batch.duration, batch.record)
+            row = instance(batch.guid).run(values, batch.duration, batch.record, batch.sound)
         except _Fatal as e:
             drop_instance(batch.guid)
             row = {**e.row, "cpu_s": float("nan")}

@@ -1,8 +1,6 @@
-"""Helpers and fixtures of the study runner's tests (imported by the test modules: a conftest.py
-here would shadow tests/python's, which its tests import by name): the FMU (a missing build
-FAILS, never skips), the `gearrattle-study` command run as a user runs it, its results read
-back, and a real Dask cluster on localhost (`dask scheduler` and two `dask worker` processes,
-started once for the session)."""
+"""Helpers of the study runner's tests (their fixtures are in tests/study/conftest.py): the
+`gearrattle-study` command run as a user runs it, its results read back, and a real Dask
+cluster on localhost (`dask scheduler` and two `dask worker` processes)."""
 
 import os
 import pathlib
@@ -11,10 +9,7 @@ import subprocess
 import sys
 
 import pyarrow.parquet as pq
-import pytest
 
-ROOT = pathlib.Path(__file__).resolve().parents[2]
-FMU = ROOT / "target" / "fmu" / "GearRattle.fmu"
 BIN = pathlib.Path(sys.executable).parent
 STUDY = BIN / "gearrattle-study"
 
@@ -93,17 +88,3 @@ class LocalhostCluster:
                 p.wait(timeout=20)
             except subprocess.TimeoutExpired:
                 p.kill()
-
-
-@pytest.fixture(scope="session")
-def fmu():
-    if not FMU.is_file():
-        pytest.fail(f"{FMU} is missing: build it with `make fmu`")
-    return str(FMU)
-
-
-@pytest.fixture(scope="session")
-def cluster(tmp_path_factory):
-    c = LocalhostCluster(tmp_path_factory.mktemp("cluster"))
-    yield c
-    c.close()

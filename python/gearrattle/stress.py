@@ -1,8 +1,8 @@
-"""The stress cases of issue 4, as data, and how each one is run and judged.
+"""The stress cases, as data, and how each one is run and judged.
 
-Shared by tests/python/test_stress.py (pytest: one test per case) and
-scripts/stability_report.py (docs/STABILITY.md: one row per case), so that the report says
-exactly what the tests check.
+Shared by tests/python/test_stress.py (pytest: one test per case) and the stability report
+(gearrattle.stability, docs/STABILITY.md: one row per case), so that the report says exactly
+what the tests check.
 
 Every case runs the FMU in sine mode (excitation = 1, MODEL.md §5) from one scene of
 reference.SCENES with parameter overrides, through fmpy's low-level FMU2Slave: every
@@ -51,13 +51,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from gearrattle import reference as R
+from . import reference as R
 
-HERE = pathlib.Path(__file__).resolve().parent
-ROOT = HERE.parents[1]
+ROOT = pathlib.Path(__file__).resolve().parents[2]  # the repository (python/gearrattle/..)
 FMU_PATH = ROOT / "target" / "fmu" / "GearRattle.fmu"
 
-FACTOR = 10.0  # the error may be up to FACTOR × the requested tolerance (issue 4)
+FACTOR = 10.0  # the error may be up to FACTOR × the requested tolerance
 HOUR = 3600.0
 
 

@@ -1,4 +1,4 @@
-/* The FMU stepped from C alone, for the study benchmark (python -m gearrattle.study.bench):
+/* The FMU stepped from C alone, for the study benchmark (benches/study/study_bench.py):
  * one instance, and per point what the study runner does (fmi2Reset, fmi2SetupExperiment, the
  * start values, initialization, one fmi2DoStep over the duration, the outputs read).
  *

@@ -1,20 +1,20 @@
-"""make bench-study: the study runner measured beside today's engine and the FMU stepped from C,
-side by side in one run on this machine (issue 22 item 5). Prints the figures and writes them,
-with the machine and the commands, to --report (docs/STUDY_BENCH.md) and a figure beside it.
+"""make bench-study: the study runner measured beside the sampled engine and the FMU stepped
+from C, side by side in one run on this machine. Prints the figures and writes them, with the
+machine and the commands, to --report (docs/STUDY_BENCH.md) and a figure beside it.
 
-    .venv/bin/python -m gearrattle.study.bench --fmu target/fmu/GearRattle.fmu \\
+    .venv/bin/python benches/study/study_bench.py --fmu target/fmu/GearRattle.fmu \\
         --out target/bench-study --report docs/STUDY_BENCH.md
 
-1. CPU per point on the paper's map grid (16 x 13, 1 s, statistics from 0.2 s): today's engine
+1. CPU per point on the paper's map grid (16 x 13, 1 s, statistics from 0.2 s): the sampled engine
    (fmpy's simulate_fmu sampling every 50 us, statistics from the samples:
    gearrattle.study.sampled) against the runner (`gearrattle-study map`, all its processes'
    CPU, start-up included, over the points), with the impact counts and run lengths compared
    point by point.
 2. The runner's CPU per point (the worker's time.process_time around a point) against the same
-   points stepped from C alone (c/step_points.c: one instance, the same calls).
+   points stepped from C alone (step_points.c beside this file: one instance, the same calls).
 3. A 10 000-point tolerance Monte Carlo of S1 (G, I_L, C, K_star varied) on 2 workers: wall time
    with the cluster's start-up.
-4. The map on a grid four times finer (32 x 26 = 832 points): today's engine (2 processes) and
+4. The map on a grid four times finer (32 x 26 = 832 points): the sampled engine (2 processes) and
    the runner (2 workers), wall time with start-up.
 5. Throughput (points per second, cluster already up) with 2 workers against 1: the median of
    PAIRS pairs, each measured one right after the other."""
@@ -33,8 +33,8 @@ import zipfile
 import numpy as np
 import pyarrow.parquet as pq
 
-from . import engine, sampled, spec
-from .model import read_model
+from gearrattle.study import engine, sampled, spec
+from gearrattle.study.model import read_model
 
 GRID = ("f_exc=30:60:16", "A_rms=100:700:13")
 FINE = ("f_exc=30:60:32", "A_rms=100:700:26")
@@ -66,8 +66,9 @@ def grid_values(x, y):
         "gearrattle.study.designs", fromlist=["points"]).points(st)]
 
 
-def today(fmu_dir, points, workers):
-    """Today's engine over the points on `workers` processes: (statistics, CPU s, wall s)."""
+def run_sampled(fmu_dir, points, workers):
+    """The sampled engine (gearrattle.study.sampled) over the points on `workers` processes:
+    (statistics, CPU s, wall s)."""
     t0 = time.perf_counter()
     stats, cpu = sampled.run(fmu_dir, points, workers, DURATION, T_FROM)
     return stats, np.array(cpu), time.perf_counter() - t0
@@ -76,7 +77,7 @@ def today(fmu_dir, points, workers):
 def from_c(fmu, fmu_dir, model, table, params, metrics, tmp):
     """The table's points stepped from C: (CPU s of the points, outputs per point)."""
     exe = os.path.join(tmp, "step_points")
-    subprocess.run(["cc", "-O2", "-o", exe, os.path.join(HERE, "c", "step_points.c"), "-ldl"],
+    subprocess.run(["cc", "-O2", "-o", exe, os.path.join(HERE, "step_points.c"), "-ldl"],
                    check=True)
     lib = os.path.join(fmu_dir, "binaries", "linux64", model.model_identifier + ".so")
     P = model.parameters
@@ -136,7 +137,7 @@ def throughput(fmu, workers, n, tmp):
 
 
 def compare(table, stats):
-    """Impact counts and run lengths, runner against today's engine, point by point."""
+    """Impact counts and run lengths, runner against the sampled engine, point by point."""
     ok = np.array(table.column("status").to_pylist()) == "ok"
     col = {n: np.array(table.column(n).to_pylist(), dtype=float) for n in
            ("stat_impacts_Fplus", "stat_impacts_Fminus", "stat_run_max_Fplus",
@@ -200,8 +201,8 @@ def main(argv=None):
     metrics = [v.name for v in model.metrics]
     grid = grid_values(*GRID)
     base = ["--fmu", a.fmu, "--duration", str(DURATION), "--stats-from", str(T_FROM)]
-    # 1. today's engine and the runner on the paper's grid
-    stats, cpu_today, _ = today(fmu_dir, grid, 2)
+    # 1. the sampled engine and the runner on the paper's grid
+    stats, cpu_sampled, _ = run_sampled(fmu_dir, grid, 2)
     out1 = os.path.join(a.out, "map")
     wall_map, cpu_map = study(["map", *base, "--x", GRID[0], "--y", GRID[1], "--workers", "2"],
                               out1)
@@ -219,9 +220,9 @@ def main(argv=None):
           *sum((["--set", f"{k}={v}"] for k, v in S1.items()), []), "--n", "10000",
           "--seed", "1", "--workers", "2", "--exceed", "stat_regime>0"]
     wall_mc, cpu_mc = study(mc, os.path.join(a.out, "mc"))
-    # 4. the finer map: today's engine on 2 processes, the runner on 2 workers
+    # 4. the finer map: the sampled engine on 2 processes, the runner on 2 workers
     fine = grid_values(*FINE)
-    _, cpu_fine_today, wall_fine_today = today(fmu_dir, fine, 2)
+    _, cpu_fine_sampled, wall_fine_sampled = run_sampled(fmu_dir, fine, 2)
     wall_fine, _ = study(["map", *base, "--x", FINE[0], "--y", FINE[1], "--workers", "2"],
                          os.path.join(a.out, "fine"))
     # 5. throughput, 2 workers against 1
@@ -235,28 +236,28 @@ def main(argv=None):
     def verdict(ok):
         return "met" if ok else "NOT met"
 
-    r1 = np.mean(cpu_today) / per_point_runner
+    r1 = np.mean(cpu_sampled) / per_point_runner
     r2 = (cpu_c and np.sum(cpu_pt) / cpu_c)
     say("# Study runner benchmark")
     say("")
-    say("Generated by `make bench-study` (python -m gearrattle.study.bench); do not edit by hand. "
+    say("Generated by `make bench-study` (benches/study/study_bench.py); do not edit by hand. "
         f"Machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores; load "
         f"average {' '.join(load0)} at the start, {' '.join(load1)} at the end (the machine "
         f"is shared: wall times move with the load). FMU GUID {model.guid}.")
     say("")
     say("| measure | figure | target | verdict |")
     say("|---|---|---|---|")
-    say(f"| CPU per 1-s point, paper's grid (208 points): today's engine (fmpy every 50 us, "
-        f"statistics from samples) | {1e3 * np.mean(cpu_today):.1f} ms | | |")
+    say(f"| CPU per 1-s point, paper's grid (208 points): the sampled engine (fmpy every 50 us, "
+        f"statistics from samples) | {1e3 * np.mean(cpu_sampled):.1f} ms | | |")
     say(f"| the runner's CPU per point in the worker (reset to outputs read, mean) | "
-        f"{1e3 * np.mean(cpu_pt):.2f} ms: {np.mean(cpu_today) / np.mean(cpu_pt):.0f}x less | "
-        f">= 20x less | {verdict(np.mean(cpu_today) / np.mean(cpu_pt) >= 20)} |")
+        f"{1e3 * np.mean(cpu_pt):.2f} ms: {np.mean(cpu_sampled) / np.mean(cpu_pt):.0f}x less | "
+        f">= 20x less | {verdict(np.mean(cpu_sampled) / np.mean(cpu_pt) >= 20)} |")
     say(f"| the runner, all its processes' CPU with start-up and figures, over the 208 points "
         f"(`gearrattle-study map`, 2 workers) | {1e3 * per_point_runner:.2f} ms: "
         f"{r1:.1f}x less (start-up and figures are most of it at 208 points) | | |")
-    say(f"| same impact counts (both flanks) as today's engine | {same_counts} of {n} points | "
+    say(f"| same impact counts (both flanks) as the sampled engine | {same_counts} of {n} points | "
         f"every point | {verdict(same_counts == n)} |")
-    say(f"| same longest run as today's engine | {same_max} of {n} points; mean run per flank "
+    say(f"| same longest run as the sampled engine | {same_max} of {n} points; mean run per flank "
         f"differs by at most {dmean:.3g} | every point | {verdict(same_max == n)} |")
     say(f"| the same 208 points stepped from C alone (one instance, the same calls) | "
         f"{1e3 * cpu_c / n:.2f} ms; outputs bit-identical to the runner's at {c_same} of {n} "
@@ -266,15 +267,15 @@ def main(argv=None):
         f"{per_point_runner / (cpu_c / n):.2f} | | |")
     say(f"| all-in CPU per point of the 10 000-point Monte Carlo below (every process, start-up "
         f"and figures included) | {1e3 * cpu_mc / 1e4:.2f} ms: "
-        f"{np.mean(cpu_today) / (cpu_mc / 1e4):.0f}x less than today's engine | | |")
+        f"{np.mean(cpu_sampled) / (cpu_mc / 1e4):.0f}x less than the sampled engine | | |")
     say(f"| 10 000-point tolerance Monte Carlo of S1 (G, I_L, C, K_star), 2 workers, wall with "
         f"start-up | {wall_mc:.1f} s ({cpu_mc:.1f} s CPU: at least {cpu_mc / 2:.1f} s on 2 "
         f"cores with nothing else running) | <= 20 s | {verdict(wall_mc <= 20)} |")
-    say(f"| map 4x finer (832 points), today's engine on 2 processes, wall | "
-        f"{wall_fine_today:.1f} s ({1e3 * np.mean(cpu_fine_today):.1f} ms CPU per point) | | |")
+    say(f"| map 4x finer (832 points), the sampled engine on 2 processes, wall | "
+        f"{wall_fine_sampled:.1f} s ({1e3 * np.mean(cpu_fine_sampled):.1f} ms CPU per point) | | |")
     say(f"| the runner on 2 workers, wall with start-up | {wall_fine:.1f} s: "
-        f"{wall_fine_today / wall_fine:.1f}x faster | >= 10x | "
-        f"{verdict(wall_fine_today / wall_fine >= 10)} |")
+        f"{wall_fine_sampled / wall_fine:.1f}x faster | >= 10x | "
+        f"{verdict(wall_fine_sampled / wall_fine >= 10)} |")
     say(f"| throughput with the cluster up, 1 worker / 2 workers (2000-point mc; the median of "
         f"{PAIRS} pairs run one after the other, whose ratios are "
         f"{', '.join(f'{r:.2f}' for r in ratios)}) | "
@@ -285,13 +286,13 @@ def main(argv=None):
     say("")
     png = os.path.join(os.path.dirname(a.report), "study_bench.png")
     os.makedirs(os.path.dirname(png) or ".", exist_ok=True)
-    figure(png, [("today's engine (fmpy, 50 us samples)", float(np.mean(cpu_today))),
+    figure(png, [("sampled engine (fmpy, 50 us samples)", float(np.mean(cpu_sampled))),
                  ("runner, all processes, start-up included", per_point_runner),
                  ("runner, per point in the worker", float(np.mean(cpu_pt))),
                  ("the FMU stepped from C", cpu_c / n)])
     say(f"![CPU per point]({os.path.basename(png)})")
     say("")
-    say("Commands: `make bench-study` (python -m gearrattle.study.bench); the studies it ran are "
+    say("Commands: `make bench-study` (benches/study/study_bench.py); the studies it ran are "
         f"in {a.out}/ (map, mc, fine). Each figure is from this one run.")
     os.makedirs(os.path.dirname(a.report) or ".", exist_ok=True)
     with open(a.report, "w") as fh:

@@ -1,0 +1,131 @@
+"""The sound's cost and error against the force's sampling (make bench-sound): CPU times of the
+simulation alone (one fmi2DoStep), of the simulation stepped on the sound's grid, of the
+filtering, of writing the WAV and of the psychoacoustic metrics (MoSQITo), for a scene; and the
+pressure's error at each subsample against a 32-times-finer grid.
+
+    python -m gearrattle.sound.bench --fmu FMU [--duration 1] [--set NAME=VALUE ...]"""
+
+import argparse
+import ctypes
+import os
+import tempfile
+import time
+
+import numpy as np
+
+REFERENCE = 32  # subsample of the reference pressure
+SUBSAMPLES = (1, 2, 4, 8)
+
+
+def _cpu(f, *args, repeat=3):
+    """(smallest CPU time of `repeat` calls, the last result): the least disturbed run on a
+    shared machine."""
+    best, out = float("inf"), None
+    for _ in range(repeat):
+        t0 = time.process_time()
+        out = f(*args)
+        best = min(best, time.process_time() - t0)
+    return best, out
+
+
+def _initialised(unzipdir, md, values):
+    from fmpy import instantiate_fmu
+
+    from .meshes import _set
+
+    inst = instantiate_fmu(unzipdir, md, fmi_type="CoSimulation")
+    inst.setupExperiment(startTime=0.0)
+    _set(inst, md, values)
+    inst.enterInitializationMode()
+    inst.exitInitializationMode()
+    return inst
+
+
+def _free(inst):
+    inst.terminate()
+    inst.freeInstance()
+
+
+def alone(unzipdir, md, values, duration):
+    """CPU of one fmi2DoStep to duration: the simulation as the studies run it."""
+    inst = _initialised(unzipdir, md, values)
+    t0 = time.process_time()
+    inst.doStep(0.0, duration)
+    cpu = time.process_time() - t0
+    _free(inst)
+    return cpu
+
+
+def reads_alone(unzipdir, md, values, n):
+    """CPU of the reads of n steps of meshes.record (the forces at every step, the counters at
+    every WAV sample) without the steps: what calling the FMU from Python costs."""
+    from .meshes import SUBSAMPLE, meshes
+
+    ms = meshes(md, values)
+    inst = _initialised(unzipdir, md, values)
+    vr_f = (ctypes.c_uint * len(ms))(*[m.force.valueReference for m in ms])
+    vr_c = (ctypes.c_uint * 2)(*[c.valueReference for c in ms[0].counters])
+    F = np.zeros((n, len(ms)))
+    f_mem, c_buf = ctypes.c_double.from_buffer(F), (ctypes.c_int * 2)()
+    t0 = time.process_time()
+    for k in range(n):
+        inst.fmi2GetReal(inst.component, vr_f, len(ms), ctypes.byref(f_mem, 8 * len(ms) * k))
+        if k % SUBSAMPLE == 0:
+            inst.fmi2GetInteger(inst.component, vr_c, 2, c_buf)
+    cpu = time.process_time() - t0
+    _free(inst)
+    return cpu
+
+
+def main(argv=None):
+    import mosqito
+    from fmpy import extract, read_model_description
+
+    from ..study.spec import parse_set
+    from .meshes import SUBSAMPLE, simulate, start_values
+    from .metrics import full_scale, metrics, write_wav
+    from .modal import ModalTransfer
+    from .render import render
+
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--fmu", default=os.path.join("target", "fmu", "GearRattle.fmu"))
+    ap.add_argument("--duration", type=float, default=1.0)
+    ap.add_argument("--set", action="append", default=[], metavar="NAME=VALUE")
+    a = ap.parse_args(argv)
+    md = read_model_description(a.fmu)
+    unzip = extract(a.fmu)
+    values = start_values(md, dict(parse_set(t, f"--set {t}") for t in a.set))
+    transfer = ModalTransfer()
+    t_alone = min(alone(unzip, md, values, a.duration) for _ in range(3))
+    ref = simulate(unzip, md, values, a.duration, subsample=REFERENCE)
+    p_ref = render(ref, transfer, REFERENCE).mix
+    print(f"sound of {a.fmu} ({', '.join(f'{k} = {v:g}' for k, v in values.items())}), "
+          f"{a.duration:g} s simulated, default modal housing; CPU seconds, best of 3")
+    print(f"  simulation alone (one fmi2DoStep): {t_alone:.4f} s")
+    print(f"  {'subsample':>9s} {'step [us]':>9s} {'simulation':>10s} {'filtering':>9s} "
+          f"{'max error':>9s} {'RMS error':>9s}   (error of p against subsample {REFERENCE})")
+    for sub in SUBSAMPLES:
+        t_sim, run = _cpu(simulate, unzip, md, values, a.duration, 0.0, sub)
+        t_filt, snd = _cpu(render, run, transfer, sub)
+        e = snd.mix - p_ref
+        mark = "  <- used" if sub == SUBSAMPLE else ""
+        print(f"  {sub:9d} {run.h * 1e6:9.3f} {t_sim:10.3f} {t_filt:9.3f} "
+              f"{np.abs(e).max() / np.abs(p_ref).max():9.1e} "
+              f"{np.sqrt(np.mean(e ** 2) / np.mean(p_ref ** 2)):9.1e}{mark}")
+        if sub == SUBSAMPLE:
+            mix, steps, t_grid = snd.mix, run.steps, t_sim
+    t_reads = min(reads_alone(unzip, md, values, steps) for _ in range(3))
+    print(f"  of the simulation at subsample {SUBSAMPLE} ({t_grid:.3f} s, {steps} steps): the "
+          f"reads from Python {t_reads:.3f} s; the rest, fmi2DoStep from Python, "
+          f"{(t_grid - t_reads) / steps * 1e6:.2f} us a step")
+    with tempfile.TemporaryDirectory() as d:
+        t_wav, _ = _cpu(write_wav, os.path.join(d, "x.wav"), mix, full_scale(mix))
+    t_met, m = _cpu(metrics, mix)
+    print(f"  writing the WAV: {t_wav:.3f} s; metrics (MoSQITo {mosqito.__version__} loudness "
+          f"and sharpness, LAeq): {t_met:.3f} s")
+    print(f"  N5 {m.N5:.2f} sone, N_mean {m.N_mean:.2f} sone, sharpness {m.sharpness:.2f} acum, "
+          f"LAeq {m.LAeq:.1f} dB(A)")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,5 +1,0 @@
-"""Moved to python/gearrattle/masters.py; this alias keeps the tests'
-`import masters` working."""
-import sys
-from gearrattle import masters
-sys.modules[__name__] = masters
