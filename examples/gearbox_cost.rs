@@ -9,7 +9,7 @@
 
 use std::time::Instant;
 
-use gear_rattle::gearbox::{Flywheel, Gearbox, GearboxParams, N, PHI, xi, xi_dot};
+use gear_rattle::gearbox::{Drive, Gearbox, GearboxParams, N, PHI, xi, xi_dot};
 use gear_rattle::integrator::{Solver, Stats, System};
 use gear_rattle::physics::{Engine, Stage};
 
@@ -23,7 +23,7 @@ struct Run {
 
 /// 2 s of `p` from GEARBOX.md §6's start, sampled every 0.1 ms from 0.5 s.
 fn run(p: &GearboxParams) -> Run {
-    let (mut sys, mut y) = Gearbox::start(p, Flywheel::Engine(Engine::new(&p.engine))).unwrap();
+    let (mut sys, mut y) = Gearbox::start(p, Drive::Engine(Engine::new(&p.engine))).unwrap();
     let mut solver = Solver::new(sys.tolerance(1e-6));
     solver.interpolate_ends = true;
     let count = |sys: &Gearbox| -> Vec<u64> {
@@ -99,7 +99,7 @@ fn main() {
         for i in 0..n {
             (y[xi(i)], y[xi_dot(i)]) = (-2e-6 - 1e-8 * i as f64, 0.01);
         }
-        let sys = Gearbox::new(&p, Flywheel::Engine(Engine::new(&p.engine)), &y);
+        let sys = Gearbox::new(&p, Drive::Engine(Engine::new(&p.engine)), &y);
         let calls = 1_000_000;
         let mut acc = 0.0;
         let mut ns = f64::INFINITY;

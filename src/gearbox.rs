@@ -66,13 +66,18 @@ pub const N: usize = e_contact(MAX_GEARS);
 
 pub type State = [f64; N];
 
-/// What drives the flywheel.
+/// What drives the box.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub enum Flywheel {
-    /// The built-in engine (GEARBOX.md §4).
+pub enum Drive {
+    /// The flywheel driven by the built-in engine (GEARBOX.md §4).
     Engine(Engine),
-    /// The drivetrain's θ_F, ω_F, α_F at a communication point, extrapolated over the step.
-    Inputs(Polynomial),
+    /// The flywheel's θ_F, ω_F, α_F from the drivetrain at a communication point,
+    /// extrapolated over the step.
+    Flywheel(Polynomial),
+    /// The input side's θ_I, ω_I, α_I from the drivetrain, extrapolated alike: no damper, φ
+    /// and φ' stay 0 (they still count in the error norm's mean, which reads the tolerance
+    /// 2/(2 + 2n) looser).
+    InputSide(Polynomial),
 }
 
 /// One loose gear as the box runs it: its pair's dynamics (drag at the oil's temperature),
@@ -81,6 +86,8 @@ pub enum Flywheel {
 pub struct Gear {
     pub dynamics: Dynamics,
     pub rho: f64,
+    /// ω_S = σ ω_out.
+    pub sigma: f64,
     pub region: Region,
     pub impacts: Impacts,
 }
@@ -97,7 +104,7 @@ pub struct Gearbox {
     pub I_I: f64,
     pub c_I: f64,
     inv_I_I: f64,
-    pub flywheel: Flywheel,
+    pub drive: Drive,
     /// The guard crossed last (for [`Piecewise::rough_start`]).
     last_crossed: usize,
 }
@@ -105,22 +112,23 @@ pub struct Gearbox {
 /// The loads at one instant, shared by the right-hand side and the readouts.
 pub(crate) struct Loads {
     pub flywheel: Shaft,
-    pub omega_I: f64,
-    pub alpha_I: f64,
+    /// θ_I, ω_I, α_I.
+    pub input: Shaft,
     pub T_cl: f64,
     pub gears: [crate::physics::Loads; MAX_GEARS],
 }
 
 impl Gearbox {
     /// The box of valid `params` (see [`GearboxParams::validate`]) with the stage and
-    /// regions of φ and the ξ_i in `state`, driven by `flywheel`.
-    pub fn new(params: &GearboxParams, flywheel: Flywheel, state: &State) -> Self {
+    /// regions of φ and the ξ_i in `state`, driven by `drive`.
+    pub fn new(params: &GearboxParams, drive: Drive, state: &State) -> Self {
         let drag = params.oil.drag_factor(params.T_oil);
         let damper = Damper::new(params.damper);
         // The slots of gears the box does not have hold a gear that is never read.
         let mut gears = [Gear {
             dynamics: Dynamics::new(GearParams::paper()),
             rho: 1.0,
+            sigma: 1.0,
             region: Region::Gap,
             impacts: Impacts::default(),
         }; MAX_GEARS];
@@ -132,6 +140,7 @@ impl Gearbox {
                 region: dynamics.law.classify(state[xi(i)]),
                 dynamics,
                 rho: gear.rho,
+                sigma: gear.sigma,
                 impacts: Impacts::default(),
             };
         }
@@ -143,7 +152,7 @@ impl Gearbox {
             I_I: params.I_I,
             c_I: params.c_I * drag,
             inv_I_I: 1.0 / params.I_I,
-            flywheel,
+            drive,
             last_crossed: 0,
         }
     }
@@ -151,17 +160,14 @@ impl Gearbox {
     /// GEARBOX.md §6's start for `params`, once validated: φ = 0, the input side at the
     /// flywheel's speed, every loose gear at rigid meshing speed (ξ_i' = 0) mid-backlash;
     /// under an engine ramp ω_F(0) (and θ_F = 0) as states.
-    pub fn start(
-        params: &GearboxParams,
-        flywheel: Flywheel,
-    ) -> Result<(Self, State), GearboxParamError> {
+    pub fn start(params: &GearboxParams, drive: Drive) -> Result<(Self, State), GearboxParamError> {
         params.validate()?;
         let mut y = [0.0; N];
         for (i, gear) in params.gears.iter().enumerate() {
             y[xi(i)] = 0.5 * gear.pair.G;
         }
-        let sys = Gearbox::new(params, flywheel, &y);
-        if let Flywheel::Engine(e) = flywheel
+        let sys = Gearbox::new(params, drive, &y);
+        if let Drive::Engine(e) = drive
             && !e.is_steady()
         {
             y[omega_F(sys.n)] = e.omega_start();
@@ -178,11 +184,35 @@ impl Gearbox {
         let old = self.flywheel_at(t, y);
         y[PHI] += shaft.theta - old.theta;
         y[PHI_DOT] += shaft.omega - old.omega;
-        self.flywheel = Flywheel::Inputs(Polynomial {
+        self.drive = Drive::Flywheel(Polynomial {
             t0: t,
             at_t0: shaft,
         });
         self.settle(t, y)
+    }
+
+    /// New input-side motion from the drivetrain at t ([`Drive::InputSide`]). The loose gears
+    /// do not move, so each ξ_i = r_L,i θ_L,i − r_M,i ρ_i θ_I follows θ_I (and ξ_i' ω_I);
+    /// their regions settle. Returns the edges crossed; the caller invalidates its solver.
+    pub fn set_input_side(&mut self, t: f64, y: &mut State, shaft: Shaft) -> usize {
+        let old = self.loads(t, y).input;
+        for (i, gear) in self.gears[..self.n].iter().enumerate() {
+            let lever = gear.dynamics.params.r_M * gear.rho;
+            y[xi(i)] += lever * (old.theta - shaft.theta);
+            y[xi_dot(i)] += lever * (old.omega - shaft.omega);
+        }
+        self.drive = Drive::InputSide(Polynomial {
+            t0: t,
+            at_t0: shaft,
+        });
+        self.settle(t, y)
+    }
+
+    /// The output shaft's speed ω_out: each loose gear's carrier turns at ω_S,i = σ_i ω_out.
+    pub fn set_output_speed(&mut self, omega_out: f64) {
+        for gear in &mut self.gears[..self.n] {
+            gear.dynamics.params.omega_S = gear.sigma * omega_out;
+        }
     }
 
     /// How many loose gears the box has.
@@ -192,7 +222,7 @@ impl Gearbox {
 
     /// Whether ω_F is a state (an engine ramp).
     fn integrates_flywheel(&self) -> bool {
-        matches!(self.flywheel, Flywheel::Engine(e) if !e.is_steady())
+        matches!(self.drive, Drive::Engine(e) if !e.is_steady())
     }
 
     /// Error weights: φ on the scale of φ_1, φ' relative to itself with a floor of φ_1 per
@@ -219,16 +249,25 @@ impl Gearbox {
         }
     }
 
-    /// The flywheel's θ_F, ω_F, α_F at (t, y).
+    /// The flywheel's θ_F, ω_F, α_F at (t, y) (at rest when the input side is driven).
     #[inline]
     pub fn flywheel_at(&self, t: f64, y: &State) -> Shaft {
-        match self.flywheel {
-            Flywheel::Engine(e) => e.steady_at(t).unwrap_or(Shaft {
+        match self.drive {
+            Drive::Engine(e) => e.steady_at(t).unwrap_or(Shaft {
                 theta: y[THETA_F],
                 omega: y[omega_F(self.n)],
                 alpha: e.alpha(t),
             }),
-            Flywheel::Inputs(p) => p.at(t),
+            Drive::Flywheel(p) => p.at(t),
+            Drive::InputSide(_) => Shaft::default(),
+        }
+    }
+
+    /// The input side's imposed motion ([`Drive::InputSide`]), if it is.
+    fn imposed_input(&self) -> Option<&Polynomial> {
+        match &self.drive {
+            Drive::InputSide(p) => Some(p),
+            _ => None,
         }
     }
 
@@ -237,9 +276,13 @@ impl Gearbox {
     #[inline]
     pub(crate) fn loads(&self, t: f64, y: &State) -> Loads {
         let flywheel = self.flywheel_at(t, y);
+        let imposed = self.imposed_input().map(|p| p.at(t));
         let phi_dot = y[PHI_DOT];
-        let omega_I = flywheel.omega - phi_dot;
-        let T_cl = self.damper.torque(self.stage, y[PHI], phi_dot);
+        let omega_I = imposed.map_or(flywheel.omega - phi_dot, |s| s.omega);
+        let T_cl = match imposed {
+            Some(_) => 0.0,
+            None => self.damper.torque(self.stage, y[PHI], phi_dot),
+        };
         let gears = &self.gears[..self.n];
         let mut forces = [ContactForce::NONE; MAX_GEARS];
         let mut reaction = 0.0;
@@ -247,7 +290,9 @@ impl Gearbox {
             forces[i] = gear.dynamics.law.force(gear.region, y[xi(i)], y[xi_dot(i)]);
             reaction += gear.rho * gear.dynamics.params.r_M * forces[i].total();
         }
-        let alpha_I = (T_cl + reaction - self.c_I * omega_I) * self.inv_I_I;
+        let alpha_I = imposed.map_or((T_cl + reaction - self.c_I * omega_I) * self.inv_I_I, |s| {
+            s.alpha
+        });
         let mut loads = [crate::physics::Loads {
             force: ContactForce::NONE,
             omega_L: 0.0,
@@ -262,10 +307,14 @@ impl Gearbox {
             };
             loads[i] = gear.dynamics.respond(forces[i], y[xi_dot(i)], &driving);
         }
+        let input = Shaft {
+            theta: imposed.map_or(flywheel.theta - y[PHI], |s| s.theta),
+            omega: omega_I,
+            alpha: alpha_I,
+        };
         Loads {
             flywheel,
-            omega_I,
-            alpha_I,
+            input,
             T_cl,
             gears: loads,
         }
@@ -279,7 +328,9 @@ impl System<N> for Gearbox {
         let l = self.loads(t, y);
         let phi_dot = y[PHI_DOT];
         let mut f = [0.0; N];
-        (f[PHI], f[PHI_DOT]) = (phi_dot, l.flywheel.alpha - l.alpha_I);
+        if self.imposed_input().is_none() {
+            (f[PHI], f[PHI_DOT]) = (phi_dot, l.flywheel.alpha - l.input.alpha);
+        }
         for (i, gear) in self.gears[..self.n].iter().enumerate() {
             let (g, v) = (&l.gears[i], y[xi_dot(i)]);
             let p = &gear.dynamics.params;
@@ -292,7 +343,7 @@ impl System<N> for Gearbox {
             (f[omega_F(self.n)], f[THETA_F]) = (l.flywheel.alpha, l.flywheel.omega);
         }
         f[E_DAMPER] = self.damper.dissipative(self.stage, phi_dot) * phi_dot;
-        f[E_INPUT_DRAG] = self.c_I * l.omega_I * l.omega_I;
+        f[E_INPUT_DRAG] = self.c_I * l.input.omega * l.input.omega;
         f[W_FLYWHEEL] = l.T_cl * l.flywheel.omega;
         f
     }

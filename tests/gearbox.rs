@@ -9,24 +9,24 @@ mod common;
 
 use common::{Paper, V};
 use gear_rattle::gearbox::{
-    self, Flywheel, Gearbox, GearboxParams, PHI, PHI_DOT, State, W_FLYWHEEL, xi, xi_dot,
+    self, Drive, Gearbox, GearboxParams, PHI, PHI_DOT, State, W_FLYWHEEL, xi, xi_dot,
 };
 use gear_rattle::integrator::{Piecewise, Solver, System};
 use gear_rattle::physics::{Dynamics, Engine, Excitation, Polynomial, Shaft};
 use gear_rattle::rattle::{self, Rattle};
 
 fn engine_driven(params: &GearboxParams) -> (Gearbox, State) {
-    Gearbox::start(params, Flywheel::Engine(Engine::new(&params.engine))).unwrap()
+    Gearbox::start(params, Drive::Engine(Engine::new(&params.engine))).unwrap()
 }
 
 /// The flywheel's θ_F, ω_F, α_F at t0 from the drivetrain, and the drive they make.
-fn driven_by_inputs(t0: f64, [theta, omega, alpha]: [f64; 3]) -> (Shaft, Flywheel) {
+fn driven_by_inputs(t0: f64, [theta, omega, alpha]: [f64; 3]) -> (Shaft, Drive) {
     let at_t0 = Shaft {
         theta,
         omega,
         alpha,
     };
-    (at_t0, Flywheel::Inputs(Polynomial { t0, at_t0 }))
+    (at_t0, Drive::Flywheel(Polynomial { t0, at_t0 }))
 }
 
 /// Runs from (sys, y) to t_end in chunks of `dt`, calling `each` after every chunk.
@@ -355,6 +355,65 @@ fn new_inputs_move_the_twist_not_the_input_side() {
 fn start_refuses_invalid_parameters() {
     let mut p = GearboxParams::default_box();
     p.damper.k_2 = 0.5 * p.damper.k_1;
-    let error = Gearbox::start(&p, Flywheel::Engine(Engine::new(&p.engine))).unwrap_err();
+    let error = Gearbox::start(&p, Drive::Engine(Engine::new(&p.engine))).unwrap_err();
     assert!(error.to_string().starts_with("parameter k_2 = "), "{error}");
+}
+
+/// The input side driven by inputs (no damper): each gear is GearRattle's pair with the
+/// input side as its main shaft (r_M ρ): the same ξ'' in every region; φ, φ' stay; new
+/// inputs move each ξ_i by r_M,i ρ_i times the jump of θ_I (ξ_i' by that of ω_I), the loose
+/// gears standing; ω_S = σ ω_out.
+#[test]
+fn an_imposed_input_side_drives_gear_rattles_pairs() {
+    let mut p = GearboxParams::default_box();
+    p.gears[1].rho = 1.4;
+    p.gears[1].sigma = 0.5;
+    let input = Shaft {
+        theta: 2.0,
+        omega: 80.0,
+        alpha: -900.0,
+    };
+    let drive = Drive::InputSide(Polynomial {
+        t0: 0.0,
+        at_t0: input,
+    });
+    let (mut sys, mut y) = Gearbox::start(&p, drive).unwrap();
+    sys.set_output_speed(10.0);
+    for xi0 in [-2e-6, -0.3e-6, 30e-6, 80e-6 + 0.5e-6, 80e-6 + 4e-6] {
+        (y[xi(1)], y[xi_dot(1)]) = (xi0, 0.015);
+        sys.settle(0.0, &y);
+        let f = sys.rhs(0.003, &y);
+        let mut pair = p.gears[1].pair;
+        (pair.r_M, pair.omega_S) = (pair.r_M * 1.4, 5.0);
+        let shaft = Excitation::Polynomial(Polynomial {
+            t0: 0.0,
+            at_t0: input,
+        });
+        let rattle = Rattle::new(Dynamics::new(pair), shaft, xi0);
+        let mut yr = [0.0; rattle::N];
+        (yr[rattle::XI], yr[rattle::XI_DOT]) = (xi0, 0.015);
+        let fr = rattle.rhs(0.003, &yr);
+        let want = fr[rattle::XI_DOT];
+        assert!(
+            (f[xi_dot(1)] - want).abs() <= 1e-12 * want.abs(),
+            "{xi0}: {} vs {want}",
+            f[xi_dot(1)]
+        );
+        assert_eq!((f[PHI], f[PHI_DOT]), (0.0, 0.0));
+    }
+    let (xi_before, dot_before) = (y[xi(1)], y[xi_dot(1)]);
+    let at = sys.readout(0.0, &y).input;
+    let next = Shaft {
+        theta: at.theta_I + 1e-4,
+        omega: at.omega_I - 0.5,
+        alpha: 0.0,
+    };
+    sys.set_input_side(0.0, &mut y, next);
+    let lever = p.gears[1].pair.r_M * 1.4;
+    assert!((y[xi(1)] - (xi_before - lever * 1e-4)).abs() < 1e-15);
+    assert!((y[xi_dot(1)] - (dot_before + lever * 0.5)).abs() < 1e-12);
+    let mut solver = Solver::new(sys.tolerance(1e-7));
+    let mut t = 0.0;
+    solver.advance(&mut sys, &mut t, &mut y, 0.05).unwrap();
+    assert_eq!((y[PHI], y[PHI_DOT]), (0.0, 0.0));
 }

@@ -18,6 +18,9 @@ use crate::integrator::Jacobian;
 
 impl Jacobian<N> for Gearbox {
     fn jacobian(&self, _t: f64, y: &State) -> [[f64; N]; N] {
+        if self.imposed_input().is_some() {
+            return self.imposed_jacobian(y);
+        }
         let n = self.n;
         let ramp = self.integrates_flywheel();
         let damper = self.damper.slopes(self.stage, y[PHI_DOT]);
@@ -67,26 +70,55 @@ impl Jacobian<N> for Gearbox {
     }
 }
 
+impl Gearbox {
+    /// With the input side's motion imposed the gears are GearRattle's pairs side by side:
+    /// each gear's own block only, φ and φ' constant.
+    fn imposed_jacobian(&self, y: &State) -> [[f64; N]; N] {
+        let mut j = [[0.0; N]; N];
+        for (i, gear) in self.gears[..self.n].iter().enumerate() {
+            let p = &gear.dynamics.params;
+            let slopes = gear
+                .dynamics
+                .law
+                .slopes(gear.region, y[xi(i)], y[xi_dot(i)]);
+            j[xi(i)][xi_dot(i)] = 1.0;
+            j[xi_dot(i)][xi(i)] = -p.r_L * p.r_L * slopes.d_xi / p.I_L;
+            j[xi_dot(i)][xi_dot(i)] = -(p.r_L * p.r_L * slopes.d_xi_dot + p.C) / p.I_L;
+        }
+        j
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::gearbox::{Flywheel, GearboxParams, PHI};
+    use crate::gearbox::{Drive, GearboxParams, PHI};
     use crate::integrator::System;
-    use crate::physics::{Engine, EngineParams};
+    use crate::physics::{Engine, EngineParams, Polynomial, Shaft};
 
     /// The analytic Jacobian matches central differences of the right-hand side on every
     /// dynamic row and column, with the gears in different regions, the damper in each
-    /// stage, ρ ≠ 1, and under an engine ramp (ω_F a state).
+    /// stage, ρ ≠ 1, under an engine ramp (ω_F a state) and with the input side imposed.
     #[test]
     fn jacobian_matches_finite_differences() {
         let mut p = GearboxParams::default_box();
         p.gears[1].rho = 1.7;
         p.gears[2].pair.omega_S = 3.0;
-        for rpm_rate in [0.0, 900.0] {
-            let engine = Engine::new(&EngineParams {
+        let engine = |rpm_rate| {
+            Drive::Engine(Engine::new(&EngineParams {
                 rpm_rate,
                 ..p.engine
-            });
+            }))
+        };
+        let imposed = Drive::InputSide(Polynomial {
+            t0: 0.0,
+            at_t0: Shaft {
+                theta: 1.0,
+                omega: 80.0,
+                alpha: 500.0,
+            },
+        });
+        for drive in [engine(0.0), engine(900.0), imposed] {
             for phi in [-0.08, 0.01, 0.07] {
                 let mut y = [0.0; N];
                 (y[PHI], y[PHI_DOT]) = (phi, 0.004);
@@ -94,7 +126,7 @@ mod tests {
                 for (i, &x) in xis.iter().enumerate() {
                     (y[xi(i)], y[xi_dot(i)]) = (x, 0.01 * (i as f64 - 2.0));
                 }
-                let sys = Gearbox::new(&p, Flywheel::Engine(engine), &y);
+                let sys = Gearbox::new(&p, drive, &y);
                 let n = sys.n;
                 let dynamic = xi(n) + usize::from(sys.integrates_flywheel());
                 if sys.integrates_flywheel() {
@@ -117,7 +149,7 @@ mod tests {
                         let err = (j[r][c] - fd_slope).abs();
                         assert!(
                             err <= 1e-5 * fd_slope.abs().max(1.0),
-                            "ramp {rpm_rate}, φ {phi}: ∂f{r}/∂y{c} = {} vs {fd_slope}",
+                            "{drive:?}, φ {phi}: ∂f{r}/∂y{c} = {} vs {fd_slope}",
                             j[r][c]
                         );
                     }

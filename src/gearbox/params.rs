@@ -10,12 +10,16 @@ use crate::physics::{DamperParams, EngineParams, GearParams, Oil};
 /// The most loose gears a box has.
 pub const MAX_GEARS: usize = 8;
 
-/// One loose gear: its pair's parameters (MODEL.md §4, the drag C given at 40 °C) and the
-/// ratio ρ at which its driving gear turns with the input shaft (GEARBOX.md §1).
+/// One loose gear: its pair's parameters (MODEL.md §4, the drag C given at 40 °C), the
+/// ratio ρ at which its driving gear turns with the input shaft (GEARBOX.md §1) and its
+/// carrier's ratio σ to the output shaft.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct LooseGear {
     pub pair: GearParams,
     pub rho: f64,
+    /// Speed ratio σ of the shaft carrying the gear to the output shaft: ω_S = σ ω_out
+    /// ([`super::Gearbox::set_output_speed`]; the pair's ω_S until then).
+    pub sigma: f64,
 }
 
 /// Everything that defines a gearbox run but the drive of the flywheel by inputs.
@@ -79,6 +83,7 @@ impl GearboxParams {
                     omega_S: 0.0,
                 },
                 rho: 1.0,
+                sigma: 1.0,
             })
             .collect();
         GearboxParams {

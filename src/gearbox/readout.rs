@@ -40,7 +40,7 @@ pub struct BoxReadout {
     pub theta_F: f64,
     pub omega_F: f64,
     pub alpha_F: f64,
-    /// θ_I = θ_F − φ, ω_I, α_I.
+    /// θ_I (θ_F − φ behind the damper), ω_I, α_I.
     pub theta_I: f64,
     pub omega_I: f64,
     pub alpha_I: f64,
@@ -87,9 +87,9 @@ impl Gearbox {
                 theta_F: f.theta,
                 omega_F: f.omega,
                 alpha_F: f.alpha,
-                theta_I: f.theta - y[PHI],
-                omega_I: l.omega_I,
-                alpha_I: l.alpha_I,
+                theta_I: l.input.theta,
+                omega_I: l.input.omega,
+                alpha_I: l.input.alpha,
                 e_damper: y[E_DAMPER],
                 e_input_drag: y[E_INPUT_DRAG],
                 w_flywheel: y[W_FLYWHEEL],
