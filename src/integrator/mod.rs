@@ -10,11 +10,15 @@
 //!   controller of [`control`], or [`radau5`] (Radau IIA of order 5) while the problem is
 //!   stiff ([`stiffness`]), the first step into a piece learnt from earlier entries
 //!   (`entries`).
-//! - [`roots`]: the Illinois root finder used to locate edges on the dense output.
+//! - `edges`: where a step leaves its piece, among the system's guards, located on its dense
+//!   output with [`roots`] (the Illinois root finder).
+//! - `work`: the work counters ([`Stats`]), the errors ([`SolverError`]) and the limits of
+//!   a call, shared by the driver and the steppers.
 //! - [`options`]: the tuned constants, each with its reason.
 
 pub mod control;
 pub mod dopri5;
+mod edges;
 mod entries;
 mod left_off;
 pub mod linalg;
@@ -31,6 +35,7 @@ pub mod taylor;
 mod test_systems;
 #[cfg(test)]
 mod tests;
+mod work;
 
 pub use control::Tolerance;
 pub use radau5::Jacobian;

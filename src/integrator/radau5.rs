@@ -252,6 +252,21 @@ fn apply_increment<const N: usize>(
     }
 }
 
+/// The collocation polynomial's divided differences from the end of the step (RADAU5's
+/// CONT), from the stages' increments z: the dense output of [`RadauTrial::dense`].
+fn dense_output<const N: usize>(z: &[[f64; N]; 3]) -> [[f64; N]; 3] {
+    let mut cont = [[0.0; N]; 3];
+    for i in 0..N {
+        let (z1, z2, z3) = (z[0][i], z[1][i], z[2][i]);
+        cont[0][i] = (z2 - z3) / C2M1;
+        let ak = (z1 - z2) / C1MC2;
+        let acont3 = (ak - z1 / C1) / C2;
+        cont[1][i] = (ak - cont[0][i]) / C1M1;
+        cont[2][i] = cont[1][i] - acont3;
+    }
+    cont
+}
+
 /// The last accepted step: where it ended, its size and polynomial (starting values of the
 /// next Newton iteration by extrapolation).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -357,7 +372,8 @@ impl<const N: usize> Stepper<N> {
     }
 
     /// Takes one step of size h from (t, y0), with f0 = f(t, y0) known (it enters the error
-    /// estimate only).
+    /// estimate only): the Newton iteration from the starting values, then the error
+    /// estimate and the dense output.
     pub fn step<S: Jacobian<N>>(
         &mut self,
         sys: &S,
@@ -367,6 +383,38 @@ impl<const N: usize> Stepper<N> {
         h: f64,
     ) -> RadauTrial<N> {
         self.stats.steps += 1;
+        let Some(factors) = self.factors(sys, t, y0, h) else {
+            return self.fail(t, y0, h, Divergence::Singular, 0.5 * h);
+        };
+        let (mut z, mut w) = self.starting_values(t, y0, h);
+        let (iterations, theta) = match self.newton(sys, &factors, (t, y0, h), &mut z, &mut w) {
+            Ok(converged) => converged,
+            Err((cause, h_next)) => return self.fail(t, y0, h, cause, h_next),
+        };
+        let (y1, err, error) = self.error_estimate(sys, &factors, (t, y0, f0, h), &z);
+        RadauTrial {
+            t,
+            h,
+            y0: *y0,
+            y1,
+            err,
+            error,
+            newton: Newton::Converged { iterations },
+            theta,
+            cont: dense_output(&z),
+        }
+    }
+
+    /// The LU factors for a step of size h from (t, y0): those in use if made for h, else
+    /// made anew, from the Jacobian in use or, if none, one evaluated at (t, y0). None if a
+    /// matrix is singular.
+    fn factors<S: Jacobian<N>>(
+        &mut self,
+        sys: &S,
+        t: f64,
+        y0: &[f64; N],
+        h: f64,
+    ) -> Option<Factors<N>> {
         let jac = match self.jac {
             Some(j) => j,
             None => {
@@ -381,22 +429,20 @@ impl<const N: usize> Stepper<N> {
                 j
             }
         };
-        let factors = match self.factors {
-            Some(f) if f.h == h => f,
+        match self.factors {
+            Some(f) if f.h == h => Some(f),
             _ => {
                 self.stats.decompositions += 1;
-                match Factors::new(&jac.m, h) {
-                    Some(f) => {
-                        self.factors = Some(f);
-                        f
-                    }
-                    None => return self.fail(t, y0, h, Divergence::Singular, 0.5 * h),
-                }
+                let f = Factors::new(&jac.m, h)?;
+                self.factors = Some(f);
+                Some(f)
             }
-        };
+        }
+    }
 
-        // Starting values: the last accepted collocation polynomial, extrapolated, when this
-        // step continues it; zero otherwise.
+    /// The Newton iteration's starting values (Z, W = T⁻¹ Z): the last accepted collocation
+    /// polynomial, extrapolated, when this step continues it; zero otherwise.
+    fn starting_values(&self, t: f64, y0: &[f64; N], h: f64) -> ([[f64; N]; 3], [[f64; N]; 3]) {
         let mut z = [[0.0; N]; 3];
         let mut w = [[0.0; N]; 3];
         if let Some(a) = &self.accepted
@@ -417,7 +463,20 @@ impl<const N: usize> Stepper<N> {
                 w[2][i] = TI31 * z1 + TI32 * z2 + TI33 * z3;
             }
         }
+        (z, w)
+    }
 
+    /// RADAU5's simplified Newton iteration on the stages' increments z (and w = T⁻¹ z) of a
+    /// step of size h from (t, y0), from their starting values: its iterations and
+    /// contraction factor θ when it converges, else why not and the size to retry with.
+    fn newton<S: System<N>>(
+        &mut self,
+        sys: &S,
+        factors: &Factors<N>,
+        (t, y0, h): (f64, &[f64; N], f64),
+        z: &mut [[f64; N]; 3],
+        w: &mut [[f64; N]; 3],
+    ) -> Result<(u32, f64), (Divergence, f64)> {
         let m = self.inner.controlled;
         let mut scal = [1.0; N];
         for i in 0..m {
@@ -430,7 +489,7 @@ impl<const N: usize> Stepper<N> {
         let mut newt = 0u32;
         loop {
             if newt >= NIT {
-                return self.fail(t, y0, h, Divergence::Limit, 0.5 * h);
+                return Err((Divergence::Limit, 0.5 * h));
             }
             let stage = |c: f64, zi: &[f64; N]| {
                 let mut y = *y0;
@@ -441,7 +500,7 @@ impl<const N: usize> Stepper<N> {
             };
             let f = [stage(C1, &z[0]), stage(C2, &z[1]), stage(1.0, &z[2])];
             self.stats.rhs_evals += 3;
-            let (r1, r23) = factors.newton_increment(&f, &w, (fac1, alphn, betan));
+            let (r1, r23) = factors.newton_increment(&f, w, (fac1, alphn, betan));
             newt += 1;
             self.stats.newton_iterations += 1;
             let mut sum = 0.0;
@@ -451,7 +510,7 @@ impl<const N: usize> Stepper<N> {
             }
             let dyno = (sum / (3 * m) as f64).sqrt();
             if !dyno.is_finite() {
-                return self.fail(t, y0, h, Divergence::NonFinite, 0.5 * h);
+                return Err((Divergence::NonFinite, 0.5 * h));
             }
             if newt > 1 && newt < NIT {
                 let thq = dyno / dyno_old;
@@ -468,19 +527,30 @@ impl<const N: usize> Stepper<N> {
                     if dyth >= 1.0 {
                         let qnewt = dyth.clamp(1e-4, 20.0);
                         let hhfac = 0.8 * qnewt.powf(-1.0 / (4.0 + (NIT - 1 - newt) as f64));
-                        return self.fail(t, y0, h, Divergence::Slow, hhfac * h);
+                        return Err((Divergence::Slow, hhfac * h));
                     }
                 } else {
-                    return self.fail(t, y0, h, Divergence::Contraction, 0.5 * h);
+                    return Err((Divergence::Contraction, 0.5 * h));
                 }
             }
             dyno_old = dyno.max(UROUND);
-            apply_increment(&mut w, &mut z, &r1, &r23);
+            apply_increment(w, z, &r1, &r23);
             if self.faccon * dyno <= self.fnewt {
-                break;
+                return Ok((newt, theta));
             }
         }
+    }
 
+    /// The end of the step from the converged stages' increments z, with Hairer's error
+    /// estimate (filtered by ((γ/h) I − J)⁻¹, once more through f on a fresh start or after a
+    /// rejection when the first estimate fails): y1, the estimate and its norm.
+    fn error_estimate<S: System<N>>(
+        &mut self,
+        sys: &S,
+        factors: &Factors<N>,
+        (t, y0, f0, h): (f64, &[f64; N], &[f64; N], f64),
+        z: &[[f64; N]; 3],
+    ) -> ([f64; N], [f64; N], f64) {
         let mut y1 = *y0;
         let mut e = [0.0; N];
         let mut err = [0.0; N];
@@ -504,27 +574,7 @@ impl<const N: usize> Stepper<N> {
             factors.real.solve(&mut err);
             error = self.inner.norm(y0, &y1, &err).max(1e-10);
         }
-
-        let mut cont = [[0.0; N]; 3];
-        for i in 0..N {
-            let (z1, z2, z3) = (z[0][i], z[1][i], z[2][i]);
-            cont[0][i] = (z2 - z3) / C2M1;
-            let ak = (z1 - z2) / C1MC2;
-            let acont3 = (ak - z1 / C1) / C2;
-            cont[1][i] = (ak - cont[0][i]) / C1M1;
-            cont[2][i] = cont[1][i] - acont3;
-        }
-        RadauTrial {
-            t,
-            h,
-            y0: *y0,
-            y1,
-            err,
-            error,
-            newton: Newton::Converged { iterations: newt },
-            theta,
-            cont,
-        }
+        (y1, err, error)
     }
 
     fn fail(

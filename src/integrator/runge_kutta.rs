@@ -8,11 +8,12 @@ use serde::{Deserialize, Serialize};
 
 use super::control::{Controller, Tolerance};
 use super::dopri5::{self, EVALS_PER_STEP};
+use super::edges::locate_crossing;
 use super::entries::{Entries, Entry};
 use super::options::OPTIONS;
 use super::radau5::{Jacobian, RadauTrial, Stepper};
-use super::solver::{Budget, SolverError, Stats, locate_crossing};
 use super::stiffness::{Switch, spectral_radius, stiffness};
+use super::work::{Call, SolverError, Stats};
 use super::{Crossing, Dense, Piecewise, System};
 
 /// Which method steps (the FMU's `solver` parameter).
@@ -114,20 +115,20 @@ impl<const N: usize> RungeKutta<N> {
         self.entering = None;
     }
 
-    /// One step from (t, y) towards t_end (past it when `past`): accepted, or None when
-    /// rejected (the next attempt's size set). `rough`: the step starts on the edge of a
-    /// piece that is rough there, and its error estimate is distrusted (DOPRI5 only).
-    #[allow(clippy::too_many_arguments)]
+    /// One step from (t, y) towards the call's end time (past it when `call.past`): accepted,
+    /// or None when rejected (the next attempt's size set). `rough`: the step starts on the
+    /// edge of a piece that is rough there, and its error estimate is distrusted (DOPRI5
+    /// only).
     pub fn attempt<S: Piecewise<N> + Jacobian<N>>(
         &mut self,
         sys: &mut S,
-        (tol, stats, budget): (&Tolerance<N>, &mut Stats, &mut Budget),
+        tol: &Tolerance<N>,
+        stats: &mut Stats,
         (t, y): (f64, &[f64; N]),
-        t_end: f64,
-        past: bool,
+        call: &mut Call<N>,
         rough: bool,
-        trial: &mut dopri5::Trial<N>,
     ) -> Result<Option<Accepted<N>>, SolverError> {
+        let (t_end, past, trial) = (call.t_end, call.past, &mut call.trial);
         let k1 = self.derivative(sys, t, y, stats);
         if self.h <= 0.0 {
             // Capped by the call's length only where steps end on t_end: stepping past it,
@@ -154,7 +155,7 @@ impl<const N: usize> RungeKutta<N> {
             }
             _ => None,
         };
-        let (h, last) = budget.step(t, t_end, self.h, past)?;
+        let (h, last) = call.budget.step(t, t_end, self.h, past)?;
         let (verdict, y1, edge, h_rho) = match self.mode {
             Mode::Radau => {
                 let trial = self.implicit_step(sys, (t, y, &k1), h, stats);
@@ -201,26 +202,24 @@ impl<const N: usize> RungeKutta<N> {
         }))
     }
 
-    /// The accepted `step` from (t, y) redone to end at θ, on the edge inside it (a DOPRI5
-    /// step into `trial`; f at (t, y) is known from the step); None if Radau's Newton iteration fails on it (the next attempt's
-    /// size set).
-    #[allow(clippy::too_many_arguments)]
+    /// An accepted step from (t, y) redone with the length h that ends it on the edge inside
+    /// it (a DOPRI5 step into `trial`; f at (t, y) is known from the step); None if Radau's
+    /// Newton iteration fails on it (the next attempt's size set: h/2).
     pub fn redo<S: Piecewise<N> + Jacobian<N>>(
         &mut self,
         sys: &S,
-        (tol, stats): (&Tolerance<N>, &mut Stats),
+        tol: &Tolerance<N>,
+        stats: &mut Stats,
         (t, y): (f64, &[f64; N]),
-        step: &Accepted<N>,
-        theta: f64,
+        h: f64,
         trial: &mut dopri5::Trial<N>,
     ) -> Option<[f64; N]> {
-        let h = theta * step.h;
         let k1 = self.derivative(sys, t, y, stats);
         match self.mode {
             Mode::Radau => {
                 let trial = self.implicit_step(sys, (t, y, &k1), h, stats);
                 if !trial.converged() {
-                    self.h = 0.5 * theta * step.h;
+                    self.h = 0.5 * h;
                     return None;
                 }
                 Some(trial.y1)

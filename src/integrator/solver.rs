@@ -13,130 +13,18 @@
 
 use super::control::Tolerance;
 use super::dopri5;
+use super::edges::locate_crossing;
 use super::entries::Entry;
 use super::left_off::LeftOff;
-use super::options::OPTIONS;
 use super::passage::{self, Passage};
 use super::radau5::Jacobian;
-use super::roots::illinois;
 use super::runge_kutta::{Accepted, Mode, RungeKutta};
-use super::{Crossing, Dense, Edge, Piecewise, taylor};
+use super::work::Call;
+use super::{Crossing, Piecewise, taylor};
 use serde::{Deserialize, Serialize};
 
 pub use super::runge_kutta::Method;
-
-/// Work counters.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-pub struct Stats {
-    pub rhs_evals: u64,
-    pub accepted: u64,
-    pub rejected: u64,
-    /// Edges crossed (each costs one extra step, ending exactly on the edge).
-    pub edges: u64,
-    /// Accepted steps taken by Radau IIA (the others by DOPRI5).
-    pub implicit_steps: u64,
-    /// Jacobians evaluated and LU decompositions (pairs) made by Radau IIA.
-    pub jacobians: u64,
-    pub decompositions: u64,
-    /// Hand-overs between DOPRI5 and Radau IIA.
-    pub switches: u64,
-    /// Evaluations of a piece's solution in closed form (the free flight), in place of steps.
-    pub exact_evals: u64,
-    /// Accepted steps taken by Taylor series ([`taylor`]; counted in `accepted` too).
-    pub series_steps: u64,
-}
-
-/// Why the solver stopped short of the end time. The state is left at the last good point.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum SolverError {
-    /// The step size fell below what the time resolution allows.
-    StepTooSmall { t: f64, h: f64 },
-    /// More steps than allowed for one call.
-    TooManySteps { t: f64, steps: u64 },
-    /// The state keeps crossing edges without advancing in time.
-    Chattering { t: f64 },
-    /// The root search on a piece's exact solution made no headway (a guard creeping along
-    /// an edge).
-    SearchStalled { t: f64 },
-}
-
-impl std::fmt::Display for SolverError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            SolverError::StepTooSmall { t, h } => {
-                write!(
-                    f,
-                    "step size {h:e} s below the resolution of time at t = {t} s"
-                )
-            }
-            SolverError::TooManySteps { t, steps } => {
-                write!(
-                    f,
-                    "more than {steps} internal steps in one call, at t = {t} s"
-                )
-            }
-            SolverError::Chattering { t } => {
-                write!(f, "edge crossings without progress in time at t = {t} s")
-            }
-            SolverError::SearchStalled { t } => {
-                write!(
-                    f,
-                    "the search for the end of a free flight stalled at t = {t} s"
-                )
-            }
-        }
-    }
-}
-
-/// The limits of one call of [`Solver::advance`]: steps taken, and edges crossed at the same
-/// instant.
-#[derive(Default)]
-pub(super) struct Budget {
-    steps: u64,
-    crossings_here: u32,
-}
-
-impl Budget {
-    /// The next step from t towards t_end, `natural` long (infinite: unbounded): its size
-    /// and whether it is cut to end on t_end (not when it may step `past` it). It ends on
-    /// t_end, not a sliver before (Hairer's 1.01). Fails when the step is below the
-    /// resolution of time or the call has taken too many.
-    pub fn step(
-        &mut self,
-        t: f64,
-        t_end: f64,
-        natural: f64,
-        past: bool,
-    ) -> Result<(f64, bool), SolverError> {
-        let last = !natural.is_finite() || (!past && t + OPTIONS.sliver * natural >= t_end);
-        let h = if last { t_end - t } else { natural };
-        if h <= OPTIONS.min_step_ulps * f64::EPSILON * t.abs().max(t_end.abs()) {
-            return Err(SolverError::StepTooSmall { t, h });
-        }
-        self.steps += 1;
-        if self.steps > OPTIONS.max_steps {
-            return Err(SolverError::TooManySteps {
-                t,
-                steps: OPTIONS.max_steps,
-            });
-        }
-        Ok((h, last))
-    }
-
-    /// An edge crossed at θ of a step from t: with progress in time, or again at the same
-    /// instant, which fails after a few times.
-    fn crossing(&mut self, t: f64, theta: f64) -> Result<(), SolverError> {
-        if theta > 0.0 {
-            self.crossings_here = 0;
-        } else {
-            self.crossings_here += 1;
-            if self.crossings_here > OPTIONS.crossings_at_once {
-                return Err(SolverError::Chattering { t });
-            }
-        }
-        Ok(())
-    }
-}
+pub use super::work::{SolverError, Stats};
 
 /// An accepted step, whichever stepper took it.
 enum Taken<'a, const N: usize> {
@@ -180,6 +68,19 @@ struct Ahead<const N: usize> {
 }
 
 impl<const N: usize> Ahead<N> {
+    /// The step from t0 of length h to y1 (ending on `edge`, if any), with its dense output;
+    /// what the caller is given is recorded by the first `serve`.
+    fn new(t0: f64, h: f64, dense: Interpolant<N>, y1: [f64; N], edge: Option<Crossing>) -> Self {
+        Ahead {
+            t0,
+            h,
+            dense,
+            y1,
+            edge,
+            left_off: LeftOff::at(t0, &y1),
+        }
+    }
+
     /// Where the kept step ends.
     fn t1(&self) -> f64 {
         self.t0 + self.h
@@ -303,9 +204,8 @@ impl<const N: usize> Solver<N> {
             return Ok(());
         }
         self.resume(sys, t, y);
-        let mut budget = Budget::default();
-        // The DOPRI5 steps are written here in place (see `dopri5::step`), the series too.
-        let mut trial = dopri5::Trial::empty();
+        let mut call = Call::new(t_end);
+        // The series are written here in place, the DOPRI5 steps in `call.trial`.
         let mut series = [[0.0; N]; taylor::TERMS];
         while *t < t_end {
             if !self.just_crossed && sys.settle(*t, y) > 0 {
@@ -317,11 +217,11 @@ impl<const N: usize> Solver<N> {
                     Flow::Done => return Ok(()),
                 }
             }
-            let past = self.interpolate_ends && self.rk.mode == Mode::Dopri5;
+            call.past = self.interpolate_ends && self.rk.mode == Mode::Dopri5;
             let series_step;
             let step = if self.rk.mode == Mode::Dopri5 && sys.series(*t, y, &mut series) {
                 let natural = taylor::Step::length(&series, &self.tol);
-                let (h, last) = budget.step(*t, t_end, natural, past)?;
+                let (h, last) = call.budget.step(*t, t_end, natural, call.past)?;
                 series_step = taylor::Step::new(series, h);
                 sys.observe(*t, h, &series_step);
                 self.stats.accepted += 1;
@@ -330,17 +230,15 @@ impl<const N: usize> Solver<N> {
                 Taken::Series(&series_step, last)
             } else {
                 let rough = self.just_crossed && sys.rough_start();
-                let work = (&self.tol, &mut self.stats, &mut budget);
-                match self
-                    .rk
-                    .attempt(sys, work, (*t, y), t_end, past, rough, &mut trial)?
-                {
+                let attempt =
+                    self.rk
+                        .attempt(sys, &self.tol, &mut self.stats, (*t, y), &mut call, rough)?;
+                match attempt {
                     Some(accepted) => Taken::RungeKutta(accepted),
                     None => continue,
                 }
             };
-            let flow = self.end_step(sys, &step, (t, y), t_end, past, &mut budget, &mut trial)?;
-            if flow == Flow::Done {
+            if self.end_step(sys, &step, t, y, &mut call)? == Flow::Done {
                 return Ok(());
             }
         }
@@ -425,22 +323,20 @@ impl<const N: usize> Solver<N> {
     /// step's own polynomial. The state is kept as the step gives it (not moved onto the
     /// edge: where the force is not zero there, that would add or remove energy at every
     /// crossing).
-    #[allow(clippy::too_many_arguments)]
     fn end_step<S: Piecewise<N> + Jacobian<N>>(
         &mut self,
         sys: &mut S,
         step: &Taken<N>,
-        (t, y): (&mut f64, &mut [f64; N]),
-        t_end: f64,
-        past: bool,
-        budget: &mut Budget,
-        trial: &mut dopri5::Trial<N>,
+        t: &mut f64,
+        y: &mut [f64; N],
+        call: &mut Call<N>,
     ) -> Result<Flow, SolverError> {
         let (h, y1, edge) = match step {
             Taken::Series(s, _) => (s.h, s.y1, locate_crossing(sys, *s)),
             Taken::RungeKutta(a) => (a.h, a.y1, a.edge),
         };
-        let work = (&self.tol, &mut self.stats);
+        let (t_end, past) = (call.t_end, call.past);
+        let trial = &mut call.trial;
         if let Some((edge, theta)) = edge {
             if past && *t + theta * h > t_end {
                 let (dense, h_kept, y_kept) = match step {
@@ -450,34 +346,33 @@ impl<const N: usize> Solver<N> {
                     }
                     Taken::RungeKutta(a) => {
                         // Stepping past t_end, the step is DOPRI5's.
-                        self.rk.redo(sys, work, (*t, y), a, theta, trial);
+                        self.redo(sys, (*t, y), a, theta, trial);
                         self.rk.ended_on_edge(a, theta);
                         (Interpolant::Dopri5(trial.continuous()), trial.h, trial.y1)
                     }
                 };
-                self.keep(dense, h_kept, y_kept, Some(edge), (t, y), t_end);
+                let ahead = Ahead::new(*t, h_kept, dense, y_kept, Some(edge));
+                self.keep(ahead, t, y, t_end);
                 return Ok(Flow::Done);
             }
             if theta > 0.0 {
                 *y = match step {
                     Taken::Series(s, _) => s.at(theta),
-                    Taken::RungeKutta(a) => {
-                        match self.rk.redo(sys, work, (*t, y), a, theta, trial) {
-                            Some(y_edge) => y_edge,
-                            None => return Ok(Flow::Go),
-                        }
-                    }
+                    Taken::RungeKutta(a) => match self.redo(sys, (*t, y), a, theta, trial) {
+                        Some(y_edge) => y_edge,
+                        None => return Ok(Flow::Go),
+                    },
                 };
                 *t += theta * h;
             }
-            budget.crossing(*t, theta)?;
+            call.budget.crossing(*t, theta)?;
             self.cross(sys, edge, *t, y);
             if let Taken::RungeKutta(a) = step {
                 self.rk.ended_on_edge(a, theta);
             }
             return Ok(Flow::Go);
         }
-        budget.crossings_here = 0;
+        call.budget.advanced();
         self.just_crossed = false;
         let last = match step {
             Taken::Series(_, last) => *last,
@@ -491,12 +386,27 @@ impl<const N: usize> Solver<N> {
                 Taken::Series(s, _) => Interpolant::Taylor(**s),
                 Taken::RungeKutta(_) => Interpolant::Dopri5(trial.continuous()),
             };
-            self.keep(dense, h, y1, None, (t, y), t_end);
+            self.keep(Ahead::new(*t, h, dense, y1, None), t, y, t_end);
             return Ok(Flow::Done);
         }
         *t = if last { t_end } else { *t + h };
         *y = y1;
         Ok(Flow::Go)
+    }
+
+    /// The accepted Runge-Kutta `step` from (t, y) redone to end at θ, on the edge inside it
+    /// (see [`RungeKutta::redo`]).
+    fn redo<S: Piecewise<N> + Jacobian<N>>(
+        &mut self,
+        sys: &S,
+        (t, y): (f64, &[f64; N]),
+        step: &Accepted<N>,
+        theta: f64,
+        trial: &mut dopri5::Trial<N>,
+    ) -> Option<[f64; N]> {
+        let h = theta * step.h;
+        self.rk
+            .redo(sys, &self.tol, &mut self.stats, (t, y), h, trial)
     }
 
     /// Crosses `edge` at (t, y): the system changes piece, and what was known of the old one
@@ -513,106 +423,10 @@ impl<const N: usize> Solver<N> {
         self.just_crossed = true;
     }
 
-    /// Keeps a step from (t, y) of length h to y1 that reaches past t_end (ending on `edge`,
-    /// if any) and hands out (t_end, y(t_end)) from its dense output.
-    fn keep(
-        &mut self,
-        dense: Interpolant<N>,
-        h: f64,
-        y1: [f64; N],
-        edge: Option<Crossing>,
-        (t, y): (&mut f64, &mut [f64; N]),
-        t_end: f64,
-    ) {
-        let mut ahead = Ahead {
-            t0: *t,
-            h,
-            dense,
-            y1,
-            edge,
-            left_off: LeftOff::at(t_end, y),
-        };
+    /// Keeps a step that reaches past t_end and hands out (t_end, y(t_end)) from its dense
+    /// output.
+    fn keep(&mut self, mut ahead: Ahead<N>, t: &mut f64, y: &mut [f64; N], t_end: f64) {
         (*t, *y) = (t_end, ahead.serve(t_end));
         self.kept = Some(Kept::Step(ahead));
-    }
-}
-
-/// The earliest edge that the accepted step leaves its piece through, among all guards of
-/// `sys`, and the fraction θ of the step at which it does (each guard located by
-/// [`locate_edge`]; a tie goes to the lower guard).
-pub(crate) fn locate_crossing<S: Piecewise<N>, T: Dense<N>, const N: usize>(
-    sys: &S,
-    step: &T,
-) -> Option<(Crossing, f64)> {
-    let mut first: Option<(Crossing, f64)> = None;
-    for guard in 0..sys.guards() {
-        let (lo, hi) = sys.piece(guard);
-        if let Some((edge, theta)) = locate_edge(step, S::guard(guard), lo, hi)
-            && first.is_none_or(|(_, earliest)| theta < earliest)
-        {
-            first = Some((Crossing { guard, edge }, theta));
-        }
-    }
-    first
-}
-
-/// Whether the accepted trial leaves [lo, hi] on a guard component, and where: the edge and
-/// the fraction θ of the step at which the dense output first reaches it. The rate of the
-/// guard tells the shape of the trajectory inside the step: moving out then back in (a graze,
-/// decided by the extremum, so it is not skipped), moving in then out (the exit can only come
-/// after the extremum, which matters when the step starts on the edge it just crossed), or
-/// monotone.
-pub(crate) fn locate_edge<T: Dense<N>, const N: usize>(
-    trial: &T,
-    (g, r): (usize, usize),
-    lo: f64,
-    hi: f64,
-) -> Option<(Edge, f64)> {
-    let (y0, y1) = trial.ends();
-    let extremum = || illinois(|th| trial.dense(r, th), 0.0, 1.0, 1e-12);
-    let find = |edge: Edge, level: f64| -> Option<f64> {
-        let outside = |v: f64| match edge {
-            Edge::Lower => v < level,
-            Edge::Upper => v > level,
-        };
-        let outward = |rate: f64| match edge {
-            Edge::Lower => rate < 0.0,
-            Edge::Upper => rate > 0.0,
-        };
-        // Starting on the edge or a rounding error beyond it (just after crossing it the
-        // other way) and moving out: the trajectory leaves at once.
-        let on_or_beyond = outside(y0[g]) || y0[g] == level;
-        if on_or_beyond && outward(y0[r]) {
-            return Some(0.0);
-        }
-        let (a, b) = match (outward(y0[r]), outward(y1[r])) {
-            (true, false) => {
-                let th = extremum();
-                if !outside(trial.dense(g, th)) {
-                    return None;
-                }
-                (0.0, th)
-            }
-            (false, true) if outside(y1[g]) => (extremum(), 1.0),
-            _ if outside(y1[g]) => (0.0, 1.0),
-            _ => return None,
-        };
-        Some(illinois(|th| trial.dense(g, th) - level, a, b, 1e-13))
-    };
-    let lower = if lo.is_finite() {
-        find(Edge::Lower, lo)
-    } else {
-        None
-    };
-    let upper = if hi.is_finite() {
-        find(Edge::Upper, hi)
-    } else {
-        None
-    };
-    match (lower, upper) {
-        (Some(a), Some(b)) if b < a => Some((Edge::Upper, b)),
-        (Some(a), _) => Some((Edge::Lower, a)),
-        (None, Some(b)) => Some((Edge::Upper, b)),
-        (None, None) => None,
     }
 }
