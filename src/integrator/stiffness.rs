@@ -18,18 +18,48 @@ use super::control::Tolerance;
 use super::dopri5;
 use super::options::OPTIONS;
 
-/// Spectral radius max |λ| of a Jacobian (Schur decomposition; infinite if J is not finite).
-/// With the step size h of the implicit method, h·ρ(J) tells whether DOPRI5 could take that
-/// step stably (its stability interval on the negative real axis is about [−3.3, 0]).
+/// Spectral radius max |λ| of a Jacobian (infinite if J is not finite). With the step size h
+/// of the implicit method, h·ρ(J) tells whether DOPRI5 could take that step stably (its
+/// stability interval on the negative real axis is about [−3.3, 0]).
+///
+/// A component that no derivative depends on (a zero column of J, the quadratures of an
+/// energy) adds the eigenvalue 0 and leaves the others those of J without its row and column
+/// (expand det(λI − J) along that column): ρ is taken on the rest, in closed form for one or
+/// two components (a gear pair's ξ, ξ'), else by a Schur decomposition. It is taken at every
+/// new Jacobian, which Radau IIA evaluates at most steps of a stiff contact.
 pub fn spectral_radius<const N: usize>(j: &[[f64; N]; N]) -> f64 {
     if j.iter().flatten().any(|v| !v.is_finite()) {
         return f64::INFINITY;
     }
-    DMatrix::from_fn(N, N, |r, c| j[r][c])
-        .complex_eigenvalues()
-        .iter()
-        .map(|l| l.norm())
-        .fold(0.0, f64::max)
+    let mut live = [0; N];
+    let mut n = 0;
+    for c in 0..N {
+        if (0..N).any(|r| j[r][c] != 0.0) {
+            live[n] = c;
+            n += 1;
+        }
+    }
+    let at = |r: usize, c: usize| j[live[r]][live[c]];
+    match n {
+        0 => 0.0,
+        1 => at(0, 0).abs(),
+        2 => {
+            // λ = tr/2 ± √disc: real when disc ≥ 0, else a conjugate pair with |λ|² = det.
+            let half_trace = 0.5 * (at(0, 0) + at(1, 1));
+            let half_diff = 0.5 * (at(0, 0) - at(1, 1));
+            let disc = half_diff * half_diff + at(0, 1) * at(1, 0);
+            if disc >= 0.0 {
+                half_trace.abs() + disc.sqrt()
+            } else {
+                (at(0, 0) * at(1, 1) - at(0, 1) * at(1, 0)).sqrt()
+            }
+        }
+        _ => DMatrix::from_fn(n, n, at)
+            .complex_eigenvalues()
+            .iter()
+            .map(|l| l.norm())
+            .fold(0.0, f64::max),
+    }
 }
 
 /// Hairer's stiffness estimate from an explicit DOPRI5 step: h·ρ ≈ h·‖k7 − k6‖ / ‖y1 − y6‖
@@ -183,5 +213,12 @@ mod tests {
         let rho = spectral_radius(&Linear::A);
         assert!((rho / 1e6 - 1.0).abs() < 1e-9, "{rho}");
         assert_eq!(spectral_radius(&[[f64::NAN]]), f64::INFINITY);
+        // A quadrature (a zero column) leaves the pair's ρ; a third coupled component goes
+        // through the Schur decomposition.
+        let quadrature = [[0.0, 1.0, 0.0], [-k, -c, 0.0], [1.0, c, 0.0]];
+        assert!((spectral_radius(&quadrature) / k.sqrt() - 1.0).abs() < 1e-12);
+        let [[a, b], [d, e]] = Linear::A;
+        let coupled = [[a, b, 0.0], [d, e, 0.0], [1.0, 1.0, -5.0]];
+        assert!((spectral_radius(&coupled) / 1e6 - 1.0).abs() < 1e-9);
     }
 }
