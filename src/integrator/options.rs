@@ -62,7 +62,10 @@ pub struct Options {
     /// a damping ratio of 0.2, 2.3 at 0.035).
     pub stiff_h_rho: f64,
     /// Stiff verdicts that make a problem stiff, and accepted Radau IIA steps in a row
-    /// within DOPRI5's stability that make it non-stiff again (Hairer's 15).
+    /// within DOPRI5's stability that make it non-stiff again: 5, not Hairer's 15, because
+    /// a gear pair's stiff phases are short (a contact between two impacts) and each verdict
+    /// waited for costs a step bounded by stability (or a short implicit one); S1 (never
+    /// stiff) is not handed over either way (docs/DECISIONS.md, D36).
     pub stiff_steps: u32,
     /// Non-stiff verdicts in a row that restart the count of stiff ones (Hairer's 6).
     pub calm_steps: u32,
@@ -92,7 +95,7 @@ pub const OPTIONS: Options = Options {
     min_factor: 0.1,
     max_factor: 5.0,
     stiff_h_rho: 2.0,
-    stiff_steps: 15,
+    stiff_steps: 5,
     calm_steps: 6,
     exit_share: 1e-3,
     max_exit_evals: 100_000,

@@ -2,11 +2,11 @@
 //! (see `solver`).
 //!
 //! - explicit → implicit: Hairer's DOPRI5 estimate of h·ρ from its last two stages
-//!   ([`stiffness`]), stiff after 15 accepted steps above a threshold ([`StiffnessDetector`];
+//!   ([`stiffness`]), stiff after 5 accepted steps above a threshold ([`StiffnessDetector`];
 //!   the estimate weighed by the tolerance scales and the threshold lowered from 3.25 to 2,
 //!   see [`STIFF_H_RHO`]);
 //! - implicit → explicit: h·ρ(J) with the spectral radius of Radau's Jacobian
-//!   ([`spectral_radius`]) and the step size Radau proposes, at most the same threshold on 15
+//!   ([`spectral_radius`]) and the step size Radau proposes, at most the same threshold on 5
 //!   accepted steps in a row: DOPRI5 could then take those steps stably.
 //!
 //! [`Method::Auto`]: super::solver::Method::Auto
@@ -34,7 +34,7 @@ pub fn spectral_radius<const N: usize>(j: &[[f64; N]; N]) -> f64 {
     let mut live = [0; N];
     let mut n = 0;
     for c in 0..N {
-        if (0..N).any(|r| j[r][c] != 0.0) {
+        if j.iter().any(|row| row[c] != 0.0) {
             live[n] = c;
             n += 1;
         }
@@ -95,8 +95,8 @@ pub const STIFF_STEPS: u32 = OPTIONS.stiff_steps;
 const CALM_STEPS: u32 = OPTIONS.calm_steps;
 
 /// Hairer's DOPRI5 switching rule, fed with [`stiffness`] of each accepted step: stiff after
-/// 15 verdicts h·ρ > [`STIFF_H_RHO`], the count restarting after 6 non-stiff verdicts in a
-/// row.
+/// [`STIFF_STEPS`] (5) verdicts h·ρ > [`STIFF_H_RHO`], the count restarting after 6 non-stiff
+/// verdicts in a row.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct StiffnessDetector {
     stiff: u32,
