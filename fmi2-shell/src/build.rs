@@ -19,6 +19,8 @@
 //! Consecutive declarations of one array expand element by element. The Rust constants give
 //! each array a module, `vr::NAME`, with the value references as arrays (`vr::gear::I_L[i - 1]`).
 
+mod fmi3;
+
 use crate::contract::{Bound, Range};
 use serde::Deserialize;
 use std::collections::BTreeMap;
@@ -125,6 +127,9 @@ struct Variable {
     /// Model Exchange: this variable is the time derivative of the continuous state named
     /// here; the order of these variables is the order of the state vector.
     derivative_of: Option<String>,
+    /// An Integer's values 0, 1, ... by name and description: an Enumeration in FMI 3.0
+    /// (FMI 2.0's description states them).
+    items: Option<Vec<(String, String)>>,
 }
 
 /// A TOML number as f64 (integers are exact up to 2^53).
@@ -191,6 +196,15 @@ pub fn outputs(text: &str) -> Result<(String, String), toml::de::Error> {
     check(&contract);
     let guid = guid_of(text);
     Ok((xml(&contract, &guid), rust(&contract, &guid)))
+}
+
+/// The FMI 3.0 model description of a contract's text, with the same GUID as its
+/// instantiationToken.
+pub fn fmi3_description(text: &str) -> Result<String, toml::de::Error> {
+    let mut contract: Contract = toml::from_str(text)?;
+    expand(&mut contract);
+    check(&contract);
+    Ok(fmi3::xml(&contract, &guid_of(text)))
 }
 
 /// Replaces each array's declarations by its elements' variables, and `NAME[*].VAR` in every
@@ -435,6 +449,52 @@ fn xml_bound(inclusive: &Option<toml::Value>, inside: Option<f64>) -> Option<Str
         .or(inside.map(|x| format!("{x:?}")))
 }
 
+/// UnitDefinitions, as both editions write them.
+fn units(x: &mut String, c: &Contract) {
+    *x += "  <UnitDefinitions>\n";
+    for u in &c.unit {
+        write!(x, "    <Unit name=\"{}\"><BaseUnit", esc(&u.name)).unwrap();
+        for (k, e) in &u.base {
+            write!(x, " {k}=\"{e}\"").unwrap();
+        }
+        for (k, a) in [("factor", u.factor), ("offset", u.offset)] {
+            if let Some(a) = a {
+                write!(x, " {k}=\"{a:?}\"").unwrap();
+            }
+        }
+        *x += "/>";
+        for d in &u.display {
+            write!(
+                x,
+                "<DisplayUnit name=\"{}\" factor=\"{:?}\"/>",
+                esc(&d.name),
+                d.factor
+            )
+            .unwrap();
+        }
+        *x += "</Unit>\n";
+    }
+    *x += "  </UnitDefinitions>\n";
+}
+
+/// LogCategories and DefaultExperiment, as both editions write them.
+fn log_categories_and_experiment(x: &mut String, c: &Contract) {
+    *x += "  <LogCategories>\n";
+    for (name, description) in &c.log_categories {
+        writeln!(
+            x,
+            "    <Category name=\"{name}\" description=\"{}\"/>",
+            esc(description)
+        )
+        .unwrap();
+    }
+    *x += "  </LogCategories>\n  <DefaultExperiment";
+    for (k, v) in &c.experiment {
+        write!(x, " {k}=\"{v:?}\"").unwrap();
+    }
+    *x += "/>\n";
+}
+
 fn xml(c: &Contract, guid: &str) -> String {
     let mut x = String::new();
     let m = &c.model;
@@ -462,43 +522,10 @@ fn xml(c: &Contract, guid: &str) -> String {
     for (k, v) in &c.capabilities {
         write!(x, " {k}=\"{}\"", value(v)).unwrap();
     }
-    x += "/>\n  <UnitDefinitions>\n";
-    for u in &c.unit {
-        write!(x, "    <Unit name=\"{}\"><BaseUnit", esc(&u.name)).unwrap();
-        for (k, e) in &u.base {
-            write!(x, " {k}=\"{e}\"").unwrap();
-        }
-        for (k, a) in [("factor", u.factor), ("offset", u.offset)] {
-            if let Some(a) = a {
-                write!(x, " {k}=\"{a:?}\"").unwrap();
-            }
-        }
-        x += "/>";
-        for d in &u.display {
-            write!(
-                x,
-                "<DisplayUnit name=\"{}\" factor=\"{:?}\"/>",
-                esc(&d.name),
-                d.factor
-            )
-            .unwrap();
-        }
-        x += "</Unit>\n";
-    }
-    x += "  </UnitDefinitions>\n  <LogCategories>\n";
-    for (name, description) in &c.log_categories {
-        writeln!(
-            x,
-            "    <Category name=\"{name}\" description=\"{}\"/>",
-            esc(description)
-        )
-        .unwrap();
-    }
-    x += "  </LogCategories>\n  <DefaultExperiment";
-    for (k, v) in &c.experiment {
-        write!(x, " {k}=\"{v:?}\"").unwrap();
-    }
-    x += "/>\n  <ModelVariables>\n";
+    x += "/>\n";
+    units(&mut x, c);
+    log_categories_and_experiment(&mut x, c);
+    x += "  <ModelVariables>\n";
     for (i, v) in c.variable.iter().enumerate() {
         writeln!(x, "    <!-- index {} -->", i + 1).unwrap();
         write!(
@@ -666,6 +693,18 @@ fn rust(c: &Contract, guid: &str) -> String {
     )
     .unwrap();
     writeln!(r, "pub const MODEL_NAME: &str = {:?};", c.model.name).unwrap();
+    let states = c
+        .variable
+        .iter()
+        .filter(|v| v.derivative_of.is_some())
+        .count();
+    writeln!(r, "pub const CONTINUOUS_STATES: usize = {states};").unwrap();
+    writeln!(
+        r,
+        "pub const EVENT_INDICATORS: usize = {};",
+        c.model.event_indicators
+    )
+    .unwrap();
     if let Some(tolerance) = c.experiment.get("tolerance") {
         writeln!(r, "pub const DEFAULT_TOLERANCE: f64 = {tolerance:?};").unwrap();
     }
