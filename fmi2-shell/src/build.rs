@@ -5,7 +5,7 @@
 //!     categories and GUID the model uses (included by its `contract` module after
 //!     `use fmi2_shell::contract::*`);
 //!
-//! and restricts the cdylib's exports to the `fmi2*` functions ([`restrict_exports`]).
+//! and restricts the cdylib's exports to the `fmi2*` and `fmi3*` functions ([`restrict_exports`]).
 //!
 //! The GUID is a hash of the contract file, so the XML and the binary always carry the same
 //! one and any change of the contract changes it.
@@ -693,18 +693,6 @@ fn rust(c: &Contract, guid: &str) -> String {
     )
     .unwrap();
     writeln!(r, "pub const MODEL_NAME: &str = {:?};", c.model.name).unwrap();
-    let states = c
-        .variable
-        .iter()
-        .filter(|v| v.derivative_of.is_some())
-        .count();
-    writeln!(r, "pub const CONTINUOUS_STATES: usize = {states};").unwrap();
-    writeln!(
-        r,
-        "pub const EVENT_INDICATORS: usize = {};",
-        c.model.event_indicators
-    )
-    .unwrap();
     if let Some(tolerance) = c.experiment.get("tolerance") {
         writeln!(r, "pub const DEFAULT_TOLERANCE: f64 = {tolerance:?};").unwrap();
     }
@@ -797,7 +785,7 @@ fn rust(c: &Contract, guid: &str) -> String {
 /// ld's PE back end can only add to such a list (a second .def is merged into it;
 /// --exclude-symbols only affects automatic exports), so nothing here can take a name out.
 /// The linker set in .cargo/config.toml, mk/windows-link.sh, links with a copy of rustc's
-/// list narrowed to fmi2*; tests/windows/run.sh checks the DLL's export table.
+/// list narrowed to fmi2* and fmi3*; tests/windows/run.sh checks the DLL's export table.
 ///
 /// macOS: see `apple_link_args`.
 pub fn restrict_exports() {
@@ -812,7 +800,7 @@ pub fn restrict_exports() {
     let script = out.join("exports.map");
     fs::write(
         &script,
-        "{\n  global: fmi2*;\n  local: callback_log; *;\n};\n",
+        "{\n  global: fmi2*; fmi3*;\n  local: callback_log; *;\n};\n",
     )
     .unwrap();
     println!(
@@ -825,7 +813,7 @@ pub fn restrict_exports() {
 /// libiconv (and cargo-zigbuild adds libcharset with it), which nothing here calls; without
 /// -dead_strip_dylibs both would be load commands, and a dylib that needs libSystem alone
 /// loads on any macOS. Its install name is `@rpath/lib<crate>.dylib`, not the path it was
-/// linked at on the build machine. The exports are kept to fmi2* by mk/darwin-link.py and
+/// linked at on the build machine. The exports are kept to fmi2* and fmi3* by mk/darwin-link.py and
 /// mk/darwin-exports.py: zig's Mach-O linker ignores the exported-symbols list that rustc
 /// passes.
 fn apple_link_args() {
@@ -1005,18 +993,22 @@ mod tests {
 }
 "#;
 
-    /// Both contracts' model descriptions through fmpy's validate_fmu (the schema, variable
-    /// names, ModelStructure, start values, units). The Python with fmpy is $FMPY_PYTHON, or
+    /// Both contracts' model descriptions, FMI 2.0's and FMI 3.0's, through fmpy's
+    /// validate_fmu (the schema, variable names, ModelStructure, start values, units). The Python with fmpy is $FMPY_PYTHON, or
     /// the repository's .venv (`make setup`).
     #[test]
     fn model_descriptions_pass_fmpy_validation() {
         let python = env::var("FMPY_PYTHON")
             .unwrap_or_else(|_| format!("{}/../.venv/bin/python", env!("CARGO_MANIFEST_DIR")));
         for name in ["GearRattle", "GearboxRattle"] {
-            let (xml, _) = outputs(&contract(name)).unwrap();
-            let dir = scratch(name);
-            fs::write(dir.join("modelDescription.xml"), xml).unwrap();
-            let run = Command::new(&python)
+            let text = contract(name);
+            for (edition, xml) in [
+                ("2.0", outputs(&text).unwrap().0),
+                ("3.0", fmi3_description(&text).unwrap()),
+            ] {
+                let dir = scratch(&format!("{name}-{edition}"));
+                fs::write(dir.join("modelDescription.xml"), xml).unwrap();
+                let run = Command::new(&python)
                 .args([
                     "-c",
                     "import sys; from fmpy.validation import validate_fmu; p = validate_fmu(sys.argv[1]); print(*p, sep='\\n'); sys.exit(len(p) > 0)",
@@ -1024,8 +1016,9 @@ mod tests {
                 .arg(&dir)
                 .output()
                 .unwrap_or_else(|e| panic!("{python}: {e} (set FMPY_PYTHON or run make setup)"));
-            succeeded(name, &run);
-            fs::remove_dir_all(dir).unwrap();
+                succeeded(&format!("{name} (FMI {edition})"), &run);
+                fs::remove_dir_all(dir).unwrap();
+            }
         }
     }
 }
