@@ -449,6 +449,68 @@ fn xml_bound(inclusive: &Option<toml::Value>, inside: Option<f64>) -> Option<Str
         .or(inside.map(|x| format!("{x:?}")))
 }
 
+/// A variable's opening tag `element` up to its causality's attributes, with the value
+/// reference `vr`.
+fn variable_head(x: &mut String, element: &str, v: &Variable, vr: u32) {
+    write!(
+        x,
+        "    <{element} name=\"{}\" valueReference=\"{vr}\" description=\"{}\" causality=\"{}\" variability=\"{}\"",
+        esc(&v.name),
+        esc(&v.full_description()),
+        v.causality,
+        v.variability()
+    )
+    .unwrap();
+    if v.causality == "parameter" {
+        *x += " initial=\"exact\"";
+    }
+}
+
+/// A variable's start, unit, display unit, bounds (if `bounded`) and `derivative` (the
+/// state's index or reference) as XML attributes, each where it has one.
+fn attributes(x: &mut String, v: &Variable, bounded: bool, derivative: Option<String>) {
+    let bound = |b: Option<String>| b.filter(|_| bounded);
+    let attributes = [
+        ("start", v.start.as_ref().map(value)),
+        ("unit", v.unit.as_deref().map(esc)),
+        ("displayUnit", v.display_unit.as_deref().map(esc)),
+        (
+            "min",
+            bound(xml_bound(&v.min, v.min_exclusive.map(f64::next_up))),
+        ),
+        (
+            "max",
+            bound(xml_bound(&v.max, v.max_exclusive.map(f64::next_down))),
+        ),
+        ("derivative", derivative),
+    ];
+    for (name, a) in &attributes {
+        if let Some(a) = a {
+            write!(x, " {name}=\"{a}\"").unwrap();
+        }
+    }
+}
+
+/// The initial unknowns by `key` (of a variable's name), sorted, each once: the outputs, and
+/// the states and their derivatives (all calculated: none has a start).
+fn initial_unknowns<T: Ord>(c: &Contract, key: impl Fn(&str) -> T) -> Vec<T> {
+    let mut initial: Vec<T> = c
+        .variable
+        .iter()
+        .filter(|v| v.causality == "output" || v.derivative_of.is_some())
+        .map(|v| key(&v.name))
+        .chain(
+            c.variable
+                .iter()
+                .filter_map(|v| v.derivative_of.as_deref())
+                .map(&key),
+        )
+        .collect();
+    initial.sort();
+    initial.dedup();
+    initial
+}
+
 /// UnitDefinitions, as both editions write them.
 fn units(x: &mut String, c: &Contract) {
     *x += "  <UnitDefinitions>\n";
@@ -528,39 +590,10 @@ fn xml(c: &Contract, guid: &str) -> String {
     x += "  <ModelVariables>\n";
     for (i, v) in c.variable.iter().enumerate() {
         writeln!(x, "    <!-- index {} -->", i + 1).unwrap();
-        write!(
-            x,
-            "    <ScalarVariable name=\"{}\" valueReference=\"{}\" description=\"{}\" causality=\"{}\" variability=\"{}\"",
-            esc(&v.name),
-            v.vr,
-            esc(&v.full_description()),
-            v.causality,
-            v.variability()
-        )
-        .unwrap();
-        if v.causality == "parameter" {
-            x += " initial=\"exact\"";
-        }
+        variable_head(&mut x, "ScalarVariable", v, v.vr);
         write!(x, ">\n      <{}", v.ty).unwrap();
-        let attributes = [
-            ("start", v.start.as_ref().map(value)),
-            ("unit", v.unit.as_deref().map(esc)),
-            ("displayUnit", v.display_unit.as_deref().map(esc)),
-            ("min", xml_bound(&v.min, v.min_exclusive.map(f64::next_up))),
-            (
-                "max",
-                xml_bound(&v.max, v.max_exclusive.map(f64::next_down)),
-            ),
-            (
-                "derivative",
-                v.derivative_of.as_deref().map(|s| index_of(s).to_string()),
-            ),
-        ];
-        for (name, a) in &attributes {
-            if let Some(a) = a {
-                write!(x, " {name}=\"{a}\"").unwrap();
-            }
-        }
+        let derivative = v.derivative_of.as_deref().map(|s| index_of(s).to_string());
+        attributes(&mut x, v, true, derivative);
         x += "/>\n    </ScalarVariable>\n";
     }
     x += "  </ModelVariables>\n  <ModelStructure>\n    <Outputs>\n";
@@ -603,18 +636,7 @@ fn xml(c: &Contract, guid: &str) -> String {
         x += "    </Derivatives>\n";
     }
     x += "    <InitialUnknowns>\n";
-    // Outputs, and the states and their derivatives (all calculated: none has a start).
-    let mut initial: Vec<usize> = outputs.iter().map(|(i, _)| *i).collect();
-    initial.extend(derivatives.iter().map(|(i, _)| *i));
-    initial.extend(
-        c.variable
-            .iter()
-            .filter_map(|v| v.derivative_of.as_deref())
-            .map(index_of),
-    );
-    initial.sort();
-    initial.dedup();
-    for i in initial {
+    for i in initial_unknowns(c, index_of) {
         writeln!(x, "      <Unknown index=\"{i}\"/>").unwrap();
     }
     x += "    </InitialUnknowns>\n  </ModelStructure>\n</fmiModelDescription>\n";

@@ -69,7 +69,6 @@ macro_rules! export_co_simulation {
     ($slave:ty) => {
         $crate::exports! { mod fmi2_exports for $slave; use $crate::fmi2, $crate::state::allowed; {
             use ::std::ffi::c_char;
-            use $crate::component::{slice, slice_mut};
             use $crate::fmu_state;
 
             #[unsafe(no_mangle)]
@@ -151,28 +150,14 @@ macro_rules! export_co_simulation {
                 FMU_STATE |s| s.restore(&unsafe { fmu_state::get::<S>(state) }?.fmu);
             fn fmi2FreeFMUstate(state: *mut fmi2FMUstate)
                 FMU_STATE |_| unsafe { fmu_state::free::<S>(state) };
-            fn fmi2SerializedFMUstateSize(state: fmi2FMUstate, size: *mut usize) FMU_STATE |_| {
-                let saved = unsafe { fmu_state::get::<S>(state) }?;
-                array!(mut size, 1)[0] = fmu_state::serialize(&saved.fmu).len();
-                Ok(())
-            };
-            fn fmi2SerializeFMUstate(state: fmi2FMUstate, bytes: *mut fmi2Byte, size: usize) FMU_STATE |_| {
-                let data = fmu_state::serialize(&unsafe { fmu_state::get::<S>(state) }?.fmu);
-                if data.len() != size {
-                    return Err(FmiError::error(format!(
-                        "size {size} given, the serialized state has {} bytes (fmi2SerializedFMUstateSize)",
-                        data.len()
-                    )));
-                }
-                unsafe { slice_mut(bytes as *mut u8, size, "serializedState") }?.copy_from_slice(&data);
-                Ok(())
-            };
-            fn fmi2DeSerializeFMUstate(bytes: *const fmi2Byte, size: usize, state: *mut fmi2FMUstate)
-                FMU_STATE |_| {
-                    let data = unsafe { slice(bytes as *const u8, size, "serializedState") }?;
-                    let fmu = fmu_state::deserialize::<S>(data)?;
-                    unsafe { fmu_state::store(state, fmu) }
+            fn fmi2SerializedFMUstateSize(state: fmi2FMUstate, size: *mut usize)
+                FMU_STATE |_| unsafe { fmu_state::serialized_size::<S>(state, size) };
+            fn fmi2SerializeFMUstate(state: fmi2FMUstate, bytes: *mut fmi2Byte, size: usize)
+                FMU_STATE |_| unsafe {
+                    fmu_state::serialize_into::<S>(state, bytes as *mut u8, size, "fmi2SerializedFMUstateSize")
                 };
+            fn fmi2DeSerializeFMUstate(bytes: *const fmi2Byte, size: usize, state: *mut fmi2FMUstate)
+                FMU_STATE |_| unsafe { fmu_state::deserialize_from::<S>(bytes as *const u8, size, state) };
 
             fn fmi2GetDirectionalDerivative(vUnknown_ref: *const fmi2ValueReference, nUnknown: usize,
                 vKnown_ref: *const fmi2ValueReference, nKnown: usize, dvKnown: *const fmi2Real,

@@ -21,6 +21,16 @@ pub enum FmiState {
 }
 
 impl FmiState {
+    pub const ALL: [FmiState; 7] = [
+        FmiState::Instantiated,
+        FmiState::InitializationMode,
+        FmiState::StepComplete,
+        FmiState::EventMode,
+        FmiState::ContinuousTimeMode,
+        FmiState::Terminated,
+        FmiState::Error,
+    ];
+
     fn bit(self) -> u8 {
         match self {
             FmiState::Instantiated => INSTANTIATED,

@@ -20,7 +20,6 @@ macro_rules! __fmi3_exports {
     ($slave:ty, $contract:path) => {
         ::fmi2_shell::exports! { mod fmi3_exports for $slave; use $crate::fmi3, $crate::state::allowed; {
             use ::std::ffi::c_char;
-            use ::fmi2_shell::component::{slice, slice_mut};
             use ::fmi2_shell::fmu_state;
             use ::fmi2_shell::Interface;
             use $crate::export as e3;
@@ -197,28 +196,12 @@ macro_rules! __fmi3_exports {
                 FMU_STATE |s| s.restore(&unsafe { fmu_state::get::<S>(state) }?.fmu);
             fn fmi3FreeFMUState(state: *mut fmi3FMUState)
                 FMU_STATE |_| unsafe { fmu_state::free::<S>(state) };
-            fn fmi3SerializedFMUStateSize(state: fmi3FMUState, size: *mut usize) FMU_STATE |_| {
-                let saved = unsafe { fmu_state::get::<S>(state) }?;
-                array!(mut size, 1)[0] = fmu_state::serialize(&saved.fmu).len();
-                Ok(())
-            };
-            fn fmi3SerializeFMUState(state: fmi3FMUState, bytes: *mut fmi3Byte, size: usize) FMU_STATE |_| {
-                let data = fmu_state::serialize(&unsafe { fmu_state::get::<S>(state) }?.fmu);
-                if data.len() != size {
-                    return Err(FmiError::error(format!(
-                        "size {size} given, the serialized state has {} bytes (fmi3SerializedFMUStateSize)",
-                        data.len()
-                    )));
-                }
-                unsafe { slice_mut(bytes, size, "serializedState") }?.copy_from_slice(&data);
-                Ok(())
-            };
+            fn fmi3SerializedFMUStateSize(state: fmi3FMUState, size: *mut usize)
+                FMU_STATE |_| unsafe { fmu_state::serialized_size::<S>(state, size) };
+            fn fmi3SerializeFMUState(state: fmi3FMUState, bytes: *mut fmi3Byte, size: usize)
+                FMU_STATE |_| unsafe { fmu_state::serialize_into::<S>(state, bytes, size, "fmi3SerializedFMUStateSize") };
             fn fmi3DeserializeFMUState(bytes: *const fmi3Byte, size: usize, state: *mut fmi3FMUState)
-                FMU_STATE |_| {
-                    let data = unsafe { slice(bytes, size, "serializedState") }?;
-                    let fmu = fmu_state::deserialize::<S>(data)?;
-                    unsafe { fmu_state::store(state, fmu) }
-                };
+                FMU_STATE |_| unsafe { fmu_state::deserialize_from::<S>(bytes, size, state) };
 
             fn fmi3GetDirectionalDerivative(unknowns: *const fmi3ValueReference, nUnknowns: usize,
                 knowns: *const fmi3ValueReference, nKnowns: usize, seed: *const fmi3Float64, nSeed: usize,
@@ -240,37 +223,37 @@ macro_rules! __fmi3_exports {
                 };
 
             // Configuration mode (structural parameters), clocks: not offered.
-            fn fmi3EnterConfigurationMode() SET_DEBUG_LOGGING
+            fn fmi3EnterConfigurationMode() EXPLAINED_REFUSAL
                 |_| e3::not_offered("fmi3EnterConfigurationMode: structural parameters are");
-            fn fmi3ExitConfigurationMode() SET_DEBUG_LOGGING
+            fn fmi3ExitConfigurationMode() EXPLAINED_REFUSAL
                 |_| e3::not_offered("fmi3ExitConfigurationMode: structural parameters are");
             fn fmi3GetClock(_vr: *const fmi3ValueReference, _nvr: usize, _v: *mut fmi3Clock)
-                SET_DEBUG_LOGGING |_| e3::not_offered("fmi3GetClock: clocks are");
+                EXPLAINED_REFUSAL |_| e3::not_offered("fmi3GetClock: clocks are");
             fn fmi3SetClock(_vr: *const fmi3ValueReference, _nvr: usize, _v: *const fmi3Clock)
-                SET_DEBUG_LOGGING |_| e3::not_offered("fmi3SetClock: clocks are");
+                EXPLAINED_REFUSAL |_| e3::not_offered("fmi3SetClock: clocks are");
             fn fmi3GetIntervalDecimal(_vr: *const fmi3ValueReference, _nvr: usize, _i: *mut fmi3Float64,
                 _q: *mut fmi3IntervalQualifier)
-                SET_DEBUG_LOGGING |_| e3::not_offered("fmi3GetIntervalDecimal: clocks are");
+                EXPLAINED_REFUSAL |_| e3::not_offered("fmi3GetIntervalDecimal: clocks are");
             fn fmi3GetIntervalFraction(_vr: *const fmi3ValueReference, _nvr: usize, _counters: *mut fmi3UInt64,
                 _r: *mut fmi3UInt64, _q: *mut fmi3IntervalQualifier)
-                SET_DEBUG_LOGGING |_| e3::not_offered("fmi3GetIntervalFraction: clocks are");
+                EXPLAINED_REFUSAL |_| e3::not_offered("fmi3GetIntervalFraction: clocks are");
             fn fmi3GetShiftDecimal(_vr: *const fmi3ValueReference, _nvr: usize, _s: *mut fmi3Float64)
-                SET_DEBUG_LOGGING |_| e3::not_offered("fmi3GetShiftDecimal: clocks are");
+                EXPLAINED_REFUSAL |_| e3::not_offered("fmi3GetShiftDecimal: clocks are");
             fn fmi3GetShiftFraction(_vr: *const fmi3ValueReference, _nvr: usize, _counters: *mut fmi3UInt64,
                 _r: *mut fmi3UInt64)
-                SET_DEBUG_LOGGING |_| e3::not_offered("fmi3GetShiftFraction: clocks are");
+                EXPLAINED_REFUSAL |_| e3::not_offered("fmi3GetShiftFraction: clocks are");
             fn fmi3SetIntervalDecimal(_vr: *const fmi3ValueReference, _nvr: usize, _i: *const fmi3Float64)
-                SET_DEBUG_LOGGING |_| e3::not_offered("fmi3SetIntervalDecimal: clocks are");
+                EXPLAINED_REFUSAL |_| e3::not_offered("fmi3SetIntervalDecimal: clocks are");
             fn fmi3SetIntervalFraction(_vr: *const fmi3ValueReference, _nvr: usize, _counters: *const fmi3UInt64,
                 _r: *const fmi3UInt64)
-                SET_DEBUG_LOGGING |_| e3::not_offered("fmi3SetIntervalFraction: clocks are");
+                EXPLAINED_REFUSAL |_| e3::not_offered("fmi3SetIntervalFraction: clocks are");
             fn fmi3SetShiftDecimal(_vr: *const fmi3ValueReference, _nvr: usize, _s: *const fmi3Float64)
-                SET_DEBUG_LOGGING |_| e3::not_offered("fmi3SetShiftDecimal: clocks are");
+                EXPLAINED_REFUSAL |_| e3::not_offered("fmi3SetShiftDecimal: clocks are");
             fn fmi3SetShiftFraction(_vr: *const fmi3ValueReference, _nvr: usize, _counters: *const fmi3UInt64,
                 _r: *const fmi3UInt64)
-                SET_DEBUG_LOGGING |_| e3::not_offered("fmi3SetShiftFraction: clocks are");
+                EXPLAINED_REFUSAL |_| e3::not_offered("fmi3SetShiftFraction: clocks are");
             fn fmi3ActivateModelPartition(_clock: fmi3ValueReference, _t: fmi3Float64)
-                SET_DEBUG_LOGGING |_| e3::not_offered("fmi3ActivateModelPartition: clocks are");
+                EXPLAINED_REFUSAL |_| e3::not_offered("fmi3ActivateModelPartition: clocks are");
             // Without clocks there is nothing to evaluate.
             fn fmi3EvaluateDiscreteStates() EVALUATE_DISCRETE_STATES |_| Ok(());
 

@@ -6,37 +6,28 @@
 //! entered: their functions have no state to be called in.
 
 pub mod allowed {
-    use fmi2_shell::state::{
-        ANY, CONTINUOUS, ERROR, EVENT, INITIALIZATION, INSTANTIATED, RUNNING, STEP_COMPLETE,
-        TERMINATED,
+    /// The functions FMI 3.0 keeps, in the same states as FMI 2.0 (fmi3EnterInitializationMode
+    /// takes fmi2SetupExperiment's arguments in fmi2EnterInitializationMode's state).
+    pub use fmi2_shell::state::allowed::{
+        COMPLETED_INTEGRATOR_STEP, DO_STEP, ENTER_CONTINUOUS_TIME_MODE, ENTER_INITIALIZATION_MODE,
+        EXIT_INITIALIZATION_MODE, FMU_STATE, GET, GET_CONTINUOUS,
+        NEW_DISCRETE_STATES as UPDATE_DISCRETE_STATES, RESET, SET, SET_CONTINUOUS_STATES,
+        SET_DEBUG_LOGGING, SET_TIME, TERMINATE,
     };
-    pub const SET_DEBUG_LOGGING: u8 = ANY;
-    /// fmi3EnterInitializationMode, which takes FMI 2.0's experiment set-up.
-    pub const ENTER_INITIALIZATION_MODE: u8 = INSTANTIATED;
-    pub const EXIT_INITIALIZATION_MODE: u8 = INITIALIZATION;
+    use fmi2_shell::state::{ANY, CONTINUOUS, ERROR, STEP_COMPLETE, TERMINATED};
     /// Model Exchange only: Co-Simulation's event mode is not offered.
     pub const ENTER_EVENT_MODE: u8 = CONTINUOUS;
-    pub const TERMINATE: u8 = RUNNING | ERROR;
-    pub const RESET: u8 = ANY;
-    pub const GET: u8 = INITIALIZATION | RUNNING | TERMINATED | ERROR;
-    pub const SET: u8 = INSTANTIATED | INITIALIZATION | RUNNING;
-    pub const FMU_STATE: u8 = ANY;
-    pub const DERIVATIVES: u8 = INITIALIZATION | RUNNING | TERMINATED;
-    /// Configuration mode, clocks, model partitions, Co-Simulation's event mode and early
-    /// return: never in a state to be called.
+    /// fmi3GetDirectionalDerivative, fmi3GetAdjointDerivative.
+    pub const DERIVATIVES: u8 = GET & !ERROR;
+    /// fmi3EnterStepMode (Co-Simulation's event mode): never in a state to be called.
     pub const NOT_OFFERED: u8 = 0;
-    // Model Exchange.
-    pub const UPDATE_DISCRETE_STATES: u8 = EVENT;
-    pub const EVALUATE_DISCRETE_STATES: u8 = EVENT | CONTINUOUS;
-    pub const ENTER_CONTINUOUS_TIME_MODE: u8 = EVENT;
-    pub const COMPLETED_INTEGRATOR_STEP: u8 = CONTINUOUS;
-    pub const SET_TIME: u8 = EVENT | CONTINUOUS;
-    pub const SET_CONTINUOUS_STATES: u8 = CONTINUOUS;
-    pub const GET_CONTINUOUS: u8 = INITIALIZATION | EVENT | CONTINUOUS | TERMINATED | ERROR;
+    /// Without clocks there is nothing to evaluate, wherever the importer asks.
+    pub const EVALUATE_DISCRETE_STATES: u8 = SET_TIME;
+    /// The functions of clocks and configuration mode: admitted in every state, so that their
+    /// body says what is not offered.
+    pub const EXPLAINED_REFUSAL: u8 = ANY;
     /// fmi3GetNumberOf{ContinuousStates,EventIndicators}: constants of the model.
     pub const GET_NUMBER_OF: u8 = ANY;
-    // Co-Simulation.
-    pub const DO_STEP: u8 = STEP_COMPLETE;
     pub const GET_OUTPUT_DERIVATIVES: u8 = STEP_COMPLETE | TERMINATED | ERROR;
 }
 
@@ -49,18 +40,10 @@ mod tests {
     #[test]
     fn the_table_follows_fmi3s_state_machine() {
         let admits = |mask: u8| -> Vec<FmiState> {
-            [
-                Instantiated,
-                InitializationMode,
-                StepComplete,
-                EventMode,
-                ContinuousTimeMode,
-                Terminated,
-                Error,
-            ]
-            .into_iter()
-            .filter(|s| s.allows(mask))
-            .collect()
+            FmiState::ALL
+                .into_iter()
+                .filter(|s| s.allows(mask))
+                .collect()
         };
         assert_eq!(admits(ENTER_INITIALIZATION_MODE), [Instantiated]);
         assert_eq!(admits(DO_STEP), [StepComplete]);

@@ -7,11 +7,15 @@
 //!     `event_indicator_k`) are declared beside the contract's.
 //!   - ModelStructure: Output, ContinuousStateDerivative, InitialUnknown and EventIndicator
 //!     elements by value reference.
-//!   - Capabilities renamed where FMI 3.0 renamed them, dropped where it has none, and the
-//!     adjoint derivatives wherever the directional ones are offered (fmi3-shell computes
-//!     them from those). Co-Simulation declares no event mode and no early return.
+//!   - Capabilities renamed where FMI 3.0 renamed them, dropped where it has none (and
+//!     canInterpolateInputs: FMI 3.0 has no fmi3SetInputDerivatives), and the adjoint
+//!     derivatives wherever the directional ones are offered (fmi3-shell computes them from
+//!     those). Co-Simulation declares no event mode and no early return.
 
-use super::{Contract, Variable, esc, log_categories_and_experiment, units, value, xml_bound};
+use super::{
+    Contract, Variable, attributes, esc, initial_unknowns, log_categories_and_experiment, units,
+    value, variable_head,
+};
 use crate::contract::fmi3::{EVENT_INDICATOR_VR, INTEGER_VR_OFFSET, TIME_VR};
 use std::fmt::Write as _;
 
@@ -47,7 +51,6 @@ fn capability(name: &str, v: &toml::Value) -> Option<(&'static str, String)> {
         "canSerializeFMUstate" => "canSerializeFMUState",
         "providesDirectionalDerivative" => "providesDirectionalDerivatives",
         "canHandleVariableCommunicationStepSize" => "canHandleVariableCommunicationStepSize",
-        "canInterpolateInputs" => "canInterpolateInputs",
         "maxOutputDerivativeOrder" => "maxOutputDerivativeOrder",
         "canBeInstantiatedOnlyOncePerProcess" => "canBeInstantiatedOnlyOncePerProcess",
         "needsExecutionTool" => "needsExecutionTool",
@@ -141,45 +144,13 @@ pub(super) fn xml(c: &Contract, token: &str) -> String {
     )
     .unwrap();
     for v in &c.variable {
-        write!(
-            x,
-            "    <{} name=\"{}\" valueReference=\"{}\" description=\"{}\" causality=\"{}\" variability=\"{}\"",
-            type_name(v),
-            esc(&v.name),
-            vr(v),
-            esc(&v.full_description()),
-            v.causality,
-            v.variability()
-        )
-        .unwrap();
-        if v.causality == "parameter" {
-            x += " initial=\"exact\"";
+        variable_head(&mut x, type_name(v), v, vr(v));
+        if let Some(name) = v.items.as_ref().map(|_| esc(&v.name)) {
+            write!(x, " declaredType=\"{name}\"").unwrap();
         }
         // An enumeration's range is its items.
-        let bounded = v.items.is_none();
-        let attributes = [
-            ("declaredType", v.items.as_ref().map(|_| esc(&v.name))),
-            ("start", v.start.as_ref().map(value)),
-            ("unit", v.unit.as_deref().map(esc)),
-            ("displayUnit", v.display_unit.as_deref().map(esc)),
-            (
-                "min",
-                xml_bound(&v.min, v.min_exclusive.map(f64::next_up)).filter(|_| bounded),
-            ),
-            (
-                "max",
-                xml_bound(&v.max, v.max_exclusive.map(f64::next_down)).filter(|_| bounded),
-            ),
-            (
-                "derivative",
-                v.derivative_of.as_deref().map(|s| by_name(s).to_string()),
-            ),
-        ];
-        for (name, a) in &attributes {
-            if let Some(a) = a {
-                write!(x, " {name}=\"{a}\"").unwrap();
-            }
-        }
+        let derivative = v.derivative_of.as_deref().map(|s| by_name(s).to_string());
+        attributes(&mut x, v, v.items.is_none(), derivative);
         x += "/>\n";
     }
     for k in 0..m.event_indicators {
@@ -227,17 +198,7 @@ pub(super) fn xml(c: &Contract, token: &str) -> String {
     for v in &derivatives {
         unknown(&mut x, "ContinuousStateDerivative", v);
     }
-    // Outputs, and the states and their derivatives (all calculated: none has a start).
-    let mut initial: Vec<u32> = outputs.iter().chain(&derivatives).map(|v| vr(v)).collect();
-    initial.extend(
-        derivatives
-            .iter()
-            .filter_map(|v| v.derivative_of.as_deref())
-            .map(by_name),
-    );
-    initial.sort();
-    initial.dedup();
-    for r in initial {
+    for r in initial_unknowns(c, by_name) {
         writeln!(x, "    <InitialUnknown valueReference=\"{r}\"/>").unwrap();
     }
     for k in 0..m.event_indicators {
