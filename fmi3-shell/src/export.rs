@@ -222,3 +222,22 @@ pub fn not_offered(what: &str) -> FmiResult {
         "{what} not offered: the model description declares none"
     )))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// FMI 3.0's Integer references are the contract's moved by the offset; a Real's, the
+    /// time's or an indicator's is no Integer.
+    #[test]
+    fn integer_references_are_moved_by_the_offset() {
+        assert_eq!(
+            integer_vrs(&[INTEGER_VR_OFFSET + 102, INTEGER_VR_OFFSET]).unwrap(),
+            [102, 0]
+        );
+        for vr in [102, TIME_VR, EVENT_INDICATOR_VR + 1] {
+            assert!(integer_vrs(&[vr]).is_err(), "{vr}");
+        }
+        assert!(scalars(3, 3).is_ok() && scalars(3, 4).is_err());
+    }
+}
