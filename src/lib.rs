@@ -9,6 +9,8 @@
 //!   dense outputs, the hand-over between them, and edge location;
 //! - [`rattle`]: the gear pair as a piecewise ODE for the integrator, with impact counting
 //!   (the shaft's motion imposed; [`rattle::torque`]: driven by a torque, 7 states);
+//! - [`gearbox`]: the gearbox of GEARBOX.md (up to 8 loose gears behind a clutch damper) as
+//!   a piecewise ODE with one guard per gear and one for the damper;
 //! - [`instance`]: the slave of fmi2-shell (variables, co-simulation stepping, Model
 //!   Exchange's states and events; the shell applies FMI's rules around it);
 //! - the `fmi2*` C exports of Co-Simulation and Model Exchange: [`fmi2_shell`]'s, around
@@ -19,6 +21,7 @@
 //!   `packaging` crate).
 
 pub mod contract;
+pub mod gearbox;
 pub mod instance;
 pub mod integrator;
 pub mod math;

@@ -16,8 +16,8 @@ use crate::integrator::taylor::{Coefficients, TERMS};
 use crate::integrator::{ClosedForm, Dense, Edge, Jacobian, Piecewise, System, Tolerance};
 use crate::math;
 use crate::physics::{
-    ContactSeries, Dynamics, Excitation, Flight, FlightStart, FlightState, GearParams, Loads,
-    Region, Shaft,
+    ContactLaw, ContactSeries, Dynamics, Excitation, Flight, FlightStart, FlightState, GearParams,
+    Loads, Region, Shaft,
 };
 use window::{Quadratures, Window, quadrature};
 
@@ -100,9 +100,11 @@ impl<const N: usize> KinematicRattle<N> {
 }
 
 /// What the co-simulation reads from the gear pair whatever drives its main shaft: ξ and ξ'
-/// are the components `GUARD` and `RATE`; the quadratures of [`window::quadrature`] follow
-/// each other from `E_CONTACT` on.
+/// are the components `XI` and `XI_DOT` (the one guard and its rate); the quadratures of
+/// [`window::quadrature`] follow each other from `E_CONTACT` on.
 pub trait GearPair<const N: usize>: Piecewise<N> {
+    const XI: usize;
+    const XI_DOT: usize;
     const E_CONTACT: usize;
     fn dynamics(&self) -> &Dynamics;
     fn region(&self) -> Region;
@@ -123,7 +125,7 @@ pub trait GearPair<const N: usize>: Piecewise<N> {
     /// The loads at (t, y) in the current region.
     fn loads_at(&self, t: f64, y: &[f64; N]) -> Loads {
         let shaft = self.shaft(t, y);
-        let (xi, xi_dot) = (y[Self::GUARD], y[Self::RATE]);
+        let (xi, xi_dot) = (y[Self::XI], y[Self::XI_DOT]);
         self.dynamics().loads(self.region(), xi, xi_dot, &shaft)
     }
     /// The quadratures at y; 0 for those the state does not carry.
@@ -144,8 +146,30 @@ pub(crate) fn scales(p: &GearParams) -> (f64, f64) {
     (p.G, p.G * p.contact_frequency().min(FLIGHT_RATE))
 }
 
-/// The region entered through `edge` at t: an onset counted in `impacts` and in the window
-/// when it leaves the gap, a separation in the window when it enters it.
+/// The region entered through `edge` at ξ' = xi_dot, and the flank (0: F+, 1: F−) of the
+/// onset counted in `impacts` when it leaves the gap (MODEL.md §1).
+pub(crate) fn enter_region(
+    law: &ContactLaw,
+    region: Region,
+    impacts: &mut Impacts,
+    edge: Edge,
+    xi_dot: f64,
+) -> (Region, Option<usize>) {
+    let onset = (region == Region::Gap).then(|| {
+        let flank = if edge == Edge::Lower { 0 } else { 1 };
+        impacts.count[flank] += 1;
+        impacts.last_speed = xi_dot.abs();
+        flank
+    });
+    let entered = match edge {
+        Edge::Lower => law.below(region),
+        Edge::Upper => law.above(region),
+    };
+    (entered, onset)
+}
+
+/// The region entered through `edge` at t ([`enter_region`]), with an onset recorded in the
+/// window too, and a separation when it enters the gap.
 pub(crate) fn cross_edge(
     dynamics: &Dynamics,
     region: Region,
@@ -154,17 +178,10 @@ pub(crate) fn cross_edge(
     t: f64,
     xi_dot: f64,
 ) -> Region {
-    let law = &dynamics.law;
-    if region == Region::Gap {
-        let flank = if edge == Edge::Lower { 0 } else { 1 };
-        impacts.count[flank] += 1;
-        impacts.last_speed = xi_dot.abs();
+    let (entered, onset) = enter_region(&dynamics.law, region, impacts, edge, xi_dot);
+    if let Some(flank) = onset {
         window.impact(t, flank, xi_dot.abs());
     }
-    let entered = match edge {
-        Edge::Lower => law.below(region),
-        Edge::Upper => law.above(region),
-    };
     if entered == Region::Gap {
         window.separation(t);
     }
@@ -230,7 +247,7 @@ pub(crate) fn step_peak<S: GearPair<N>, D: Dense<N>, const N: usize>(
     h: f64,
     step: &D,
 ) -> (f64, f64) {
-    let (lo, hi) = sys.piece();
+    let (lo, hi) = sys.piece(0);
     let window = sys.window();
     let r_L = sys.dynamics().params.r_L;
     let a_at = |theta: f64| {
@@ -240,7 +257,7 @@ pub(crate) fn step_peak<S: GearPair<N>, D: Dense<N>, const N: usize>(
         for (i, y) in y.iter_mut().enumerate().take(S::E_CONTACT) {
             *y = step.dense(i, theta);
         }
-        let xi = y[S::GUARD];
+        let xi = y[S::XI];
         if xi < lo || xi > hi || t < window.from {
             return 0.0;
         }
@@ -324,6 +341,8 @@ impl<const N: usize> Jacobian<N> for KinematicRattle<N> {
 macro_rules! contact_pieces {
     ($gear:ident, $shaft:item $(, $extra:item)*) => {
         impl<const N: usize> $crate::rattle::GearPair<N> for $gear<N> {
+            const XI: usize = XI;
+            const XI_DOT: usize = XI_DOT;
             const E_CONTACT: usize = E_CONTACT;
             fn dynamics(&self) -> &$crate::physics::Dynamics {
                 &self.dynamics
@@ -346,10 +365,11 @@ macro_rules! contact_pieces {
         impl<const N: usize> $crate::integrator::Piecewise<N> for $gear<N> {
             $($extra)*
 
-            const GUARD: usize = XI;
-            const RATE: usize = XI_DOT;
+            fn guard(_: usize) -> (usize, usize) {
+                (XI, XI_DOT)
+            }
 
-            fn piece(&self) -> (f64, f64) {
+            fn piece(&self, _: usize) -> (f64, f64) {
                 self.dynamics.law.bounds(self.region)
             }
 
@@ -357,7 +377,7 @@ macro_rules! contact_pieces {
                 self.dynamics.law.rough_at_onset(self.region)
             }
 
-            fn cross(&mut self, edge: $crate::integrator::Edge, t: f64, y: &[f64; N]) {
+            fn cross(&mut self, at: $crate::integrator::Crossing, t: f64, y: &[f64; N]) {
                 use $crate::rattle::GearPair;
                 if self.window.is_open_at(t) {
                     let a = self.dynamics.params.r_L * self.loads_at(t, y).alpha_L;
@@ -368,7 +388,7 @@ macro_rules! contact_pieces {
                     &self.dynamics,
                     self.region,
                     (&mut self.impacts, &mut self.window),
-                    edge,
+                    at.edge,
                     t,
                     y[XI_DOT],
                 );

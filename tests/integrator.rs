@@ -3,7 +3,9 @@
 //! and edge location (exact crossing times, each crossing counted once, grazes not skipped).
 
 use gear_rattle::integrator::dopri5;
-use gear_rattle::integrator::{Edge, Jacobian, Method, Piecewise, Solver, System, Tolerance};
+use gear_rattle::integrator::{
+    Crossing, Edge, Jacobian, Method, Piecewise, Solver, System, Tolerance,
+};
 
 /// y' = y cos t, y(0) = 1: y = exp(sin t).
 struct Exp;
@@ -22,12 +24,13 @@ impl Jacobian<1> for Exp {
 
 /// A smooth system seen as one infinite piece.
 impl Piecewise<1> for Exp {
-    const GUARD: usize = 0;
-    const RATE: usize = 0;
-    fn piece(&self) -> (f64, f64) {
+    fn guard(_: usize) -> (usize, usize) {
+        (0, 0)
+    }
+    fn piece(&self, _: usize) -> (f64, f64) {
         (f64::NEG_INFINITY, f64::INFINITY)
     }
-    fn cross(&mut self, _: Edge, _: f64, _: &[f64; 1]) {
+    fn cross(&mut self, _: Crossing, _: f64, _: &[f64; 1]) {
         unreachable!("no edges")
     }
 }
@@ -190,18 +193,19 @@ impl Jacobian<2> for TwoPieces {
 }
 
 impl Piecewise<2> for TwoPieces {
-    const GUARD: usize = 0;
-    const RATE: usize = 1;
-    fn piece(&self) -> (f64, f64) {
+    fn guard(_: usize) -> (usize, usize) {
+        (0, 1)
+    }
+    fn piece(&self, _: usize) -> (f64, f64) {
         if self.below {
             (f64::NEG_INFINITY, 0.0)
         } else {
             (0.0, f64::INFINITY)
         }
     }
-    fn cross(&mut self, edge: Edge, t: f64, _: &[f64; 2]) {
-        self.below = edge == Edge::Lower;
-        self.crossings.push((t, edge));
+    fn cross(&mut self, at: Crossing, t: f64, _: &[f64; 2]) {
+        self.below = at.edge == Edge::Lower;
+        self.crossings.push((t, at.edge));
     }
 }
 
@@ -265,5 +269,97 @@ fn a_graze_inside_one_step_is_not_skipped() {
         assert_eq!(crossings.len(), 2, "{method:?}: {crossings:?}");
         assert!((crossings[0].0 - roots[0]).abs() < 1e-9, "{method:?}");
         assert!((crossings[1].0 - roots[1]).abs() < 1e-9, "{method:?}");
+    }
+}
+
+/// Two independent coordinates, each x'' = −a above 0 and +a below, as the two guards of one
+/// system: x1 with a = 1 from 1 crosses 0 at (2k+1)√2, x2 with a = 4 from 1 at (2k+1)/√2.
+/// Every crossing of both is found where it is, in time order, by the right guard, whatever
+/// the end times asked for: steps end on the earliest crossing among the guards.
+struct TwoGuards {
+    accel: [f64; 2],
+    below: [bool; 2],
+    crossings: Vec<(f64, Crossing)>,
+}
+
+impl System<4> for TwoGuards {
+    fn rhs(&self, _t: f64, y: &[f64; 4]) -> [f64; 4] {
+        let a = |k: usize| {
+            if self.below[k] {
+                self.accel[k]
+            } else {
+                -self.accel[k]
+            }
+        };
+        [y[1], a(0), y[3], a(1)]
+    }
+}
+
+impl Jacobian<4> for TwoGuards {
+    fn jacobian(&self, _: f64, _: &[f64; 4]) -> [[f64; 4]; 4] {
+        let mut j = [[0.0; 4]; 4];
+        (j[0][1], j[2][3]) = (1.0, 1.0);
+        j
+    }
+}
+
+impl Piecewise<4> for TwoGuards {
+    fn guards(&self) -> usize {
+        2
+    }
+    fn guard(k: usize) -> (usize, usize) {
+        (2 * k, 2 * k + 1)
+    }
+    fn piece(&self, k: usize) -> (f64, f64) {
+        if self.below[k] {
+            (f64::NEG_INFINITY, 0.0)
+        } else {
+            (0.0, f64::INFINITY)
+        }
+    }
+    fn cross(&mut self, at: Crossing, t: f64, _: &[f64; 4]) {
+        self.below[at.guard] = at.edge == Edge::Lower;
+        self.crossings.push((t, at));
+    }
+}
+
+#[test]
+fn the_earliest_crossing_among_guards_ends_the_step() {
+    let sqrt2 = 2f64.sqrt();
+    let mut expected: Vec<(f64, usize)> = (0..7)
+        .map(|k| ((2 * k + 1) as f64 * sqrt2, 0))
+        .chain((0..14).map(|k| ((2 * k + 1) as f64 / sqrt2, 1)))
+        .filter(|&(t, _)| t < 20.0)
+        .collect();
+    expected.sort_by(|a, b| a.0.total_cmp(&b.0));
+    for (method, chunks) in METHODS
+        .into_iter()
+        .flat_map(|m| [(m, 1), (m, 7), (m, 1000)])
+    {
+        let mut sys = TwoGuards {
+            accel: [1.0, 4.0],
+            below: [false; 2],
+            crossings: vec![],
+        };
+        let tol = Tolerance {
+            rtol: 1e-8,
+            atol: [1e-8; 4],
+            controlled: 4,
+        };
+        let mut solver = Solver::with_method(tol, method);
+        let (mut t, mut y) = (0.0, [1.0, 0.0, 1.0, 0.0]);
+        for k in 1..=chunks {
+            solver
+                .advance(&mut sys, &mut t, &mut y, 20.0 * k as f64 / chunks as f64)
+                .unwrap();
+        }
+        assert_eq!(sys.crossings.len(), expected.len(), "{:?}", sys.crossings);
+        for (k, ((t, at), (want, guard))) in sys.crossings.iter().zip(&expected).enumerate() {
+            assert_eq!(at.guard, *guard, "{method:?}: crossing {k} at {t}");
+            assert!(
+                (t - want).abs() < 1e-9,
+                "{method:?}: crossing {k} of guard {guard} at {t}, expected {want}"
+            );
+        }
     }
 }

@@ -30,7 +30,7 @@
 
 use std::cell::Cell;
 
-use gear_rattle::integrator::{Edge, Piecewise, roots};
+use gear_rattle::integrator::{Crossing, Edge, Piecewise, roots};
 use gear_rattle::physics::{Dynamics, Excitation, GearParams, Region};
 use gear_rattle::rattle::{N, Rattle, State, XI, XI_DOT};
 
@@ -281,7 +281,7 @@ pub fn drive<S: Stepper>(
         let h_before = s.h();
         s.step(model, stop)?;
         run.steps += 1;
-        let (lo, hi) = rattle.piece();
+        let (lo, hi) = rattle.piece(0);
         if model.user.is_some() {
             // No edge handling: follow ξ's region after the step to count impacts.
             (t, y) = (s.t(), s.y());
@@ -310,7 +310,7 @@ pub fn drive<S: Stepper>(
                 if stalls > 20 {
                     return Err(format!("edge crossings without progress at t = {tc}"));
                 }
-                rattle.cross(edge, tc, &yc);
+                rattle.cross(Crossing { guard: 0, edge }, tc, &yc);
                 model.region.set(rattle.region);
                 run.edges += 1;
                 s.restart(model, tc, &yc, h_next)?;

@@ -8,7 +8,7 @@
 
 use super::*;
 use gear_rattle::integrator::taylor::Coefficients;
-use gear_rattle::integrator::{ClosedForm, Edge, Jacobian, Piecewise, System};
+use gear_rattle::integrator::{ClosedForm, Crossing, Jacobian, Piecewise, System};
 use gear_rattle::physics::Region;
 use std::cell::Cell;
 
@@ -60,12 +60,13 @@ impl Jacobian<N> for Counted {
 }
 
 impl Piecewise<N> for Counted {
-    const GUARD: usize = XI;
-    const RATE: usize = XI_DOT;
-    fn piece(&self) -> (f64, f64) {
-        self.inner.piece()
+    fn guard(k: usize) -> (usize, usize) {
+        Rattle::guard(k)
     }
-    fn cross(&mut self, edge: Edge, t: f64, y: &State) {
+    fn piece(&self, k: usize) -> (f64, f64) {
+        self.inner.piece(k)
+    }
+    fn cross(&mut self, edge: Crossing, t: f64, y: &State) {
         if matches!(self.inner.region, Region::BandPlus | Region::BandMinus) {
             self.out_of_bands += 1;
         }

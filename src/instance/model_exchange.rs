@@ -268,13 +268,13 @@ impl<S: GearPair<N> + crate::integrator::Jacobian<N> + Copy, const N: usize>
         // rounding errors further along ξ', so that an edge reached on the way out is crossed
         // now, and one just crossed is not crossed back.
         let mut probe = self.y;
-        let (xi, xi_dot) = (probe[S::GUARD], probe[S::RATE]);
-        let (lo, hi) = self.system.piece();
+        let (xi, xi_dot) = (probe[S::XI], probe[S::XI_DOT]);
+        let (lo, hi) = self.system.piece(0);
         let scale = [xi, lo, hi]
             .iter()
             .filter(|v| v.is_finite())
             .fold(0.0f64, |m, v| m.max(v.abs()));
-        probe[S::GUARD] = xi + xi_dot.signum() * 8.0 * f64::EPSILON * scale;
+        probe[S::XI] = xi + xi_dot.signum() * 8.0 * f64::EPSILON * scale;
         self.system.settle(t, &probe);
         let window = self.system.window();
         if !window.is_opened() && window.from <= t {

@@ -11,17 +11,18 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::Edge;
+use super::Crossing;
 use super::options::OPTIONS;
 
 const SLOTS: usize = OPTIONS.entry_slots;
 
-/// A piece as the integrator sees it: its bounds, and the edge of the piece left behind.
+/// A piece as the integrator sees it: its guard's bounds, and the edge of the piece left
+/// behind (with its guard).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub(super) struct Entry {
     pub lo: f64,
     pub hi: f64,
-    pub through: Edge,
+    pub through: Crossing,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -74,12 +75,13 @@ impl Entries {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::integrator::Edge;
 
-    fn entry(lo: f64, through: Edge) -> Entry {
+    fn entry(lo: f64, edge: Edge) -> Entry {
         Entry {
             lo,
             hi: lo + 1.0,
-            through,
+            through: Crossing { guard: 0, edge },
         }
     }
 
@@ -103,6 +105,14 @@ mod tests {
             "growth capped at 5"
         );
         assert_eq!(e.ratio(&entry(0.0, Edge::Upper)), 1.0);
+        let other_guard = Entry {
+            through: Crossing {
+                guard: 1,
+                edge: Edge::Lower,
+            },
+            ..a
+        };
+        assert_eq!(e.ratio(&other_guard), 1.0, "guards are told apart");
         for k in 1..=SLOTS {
             e.learn(&entry(k as f64, Edge::Upper), 1.0, 2.0);
         }

@@ -53,8 +53,9 @@ pub trait Dense<const N: usize> {
 pub trait ClosedForm<const N: usize> {
     /// The state at t ≥ t0.
     fn at(&self, t: f64) -> [f64; N];
-    /// A bound on |d² y[GUARD] / dt²| along the solution from t0 on, for as long as it stays
-    /// in the piece: what keeps the root search from stepping over a crossing.
+    /// A bound on |d² g / dt²| along the solution from t0 on, g being guard 0's component,
+    /// for as long as it stays in the piece: what keeps the root search from stepping over a
+    /// crossing.
     fn guard_acceleration_bound(&self) -> f64;
 }
 
@@ -77,21 +78,39 @@ pub enum Edge {
     Upper,
 }
 
-/// A system whose right-hand side is smooth only piecewise: the current piece is valid while
-/// component `GUARD` stays within `piece()`, and component `RATE` is the time derivative of
-/// `GUARD` (used to find extrema inside a step, so that a grazing crossing is not skipped).
+/// An edge crossed by one of a system's guards: guard `guard` leaves its piece through `edge`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct Crossing {
+    pub guard: usize,
+    pub edge: Edge,
+}
+
+/// A system whose right-hand side is smooth only piecewise. It has `guards()` guards: guard k
+/// is the component `guard(k).0` of the state, and the current piece is valid while every
+/// guard k stays within its interval `piece(k)`. The component `guard(k).1` is the time
+/// derivative of guard k (used to find its extrema inside a step, so that a grazing crossing
+/// is not skipped). A step ends on the earliest crossing among all guards. A system with one
+/// guard (the gear pair: ξ) loops over that one only, with the same arithmetic as if the
+/// solver knew of no other.
 pub trait Piecewise<const N: usize>: System<N> {
-    const GUARD: usize;
-    const RATE: usize;
+    /// How many guards the system has (at least 1): guards 0 .. guards() − 1.
+    #[inline]
+    fn guards(&self) -> usize {
+        1
+    }
 
-    /// The interval [lo, hi] of `y[GUARD]` over which the current piece is valid.
-    fn piece(&self) -> (f64, f64);
+    /// The components of guard k and of its rate.
+    fn guard(k: usize) -> (usize, usize);
 
-    /// Switches to the neighbouring piece through `edge` at time t and state y.
-    fn cross(&mut self, edge: Edge, t: f64, y: &[f64; N]);
+    /// The interval [lo, hi] of guard k over which the current piece is valid.
+    fn piece(&self, k: usize) -> (f64, f64);
 
-    /// Whether the right-hand side of the current piece is rough where the piece begins (a
-    /// non-integer power below 3 of the distance to its edge): the solution is then not
+    /// Switches to the neighbouring piece through the edge `at` (of guard `at.guard`) at time
+    /// t and state y.
+    fn cross(&mut self, at: Crossing, t: f64, y: &[f64; N]);
+
+    /// Whether the right-hand side of the piece just entered is rough where the piece begins
+    /// (a non-integer power below 3 of the distance to its edge): the solution is then not
     /// smooth at the start of the first step, whose error estimate the solver distrusts.
     fn rough_start(&self) -> bool {
         false
@@ -101,7 +120,8 @@ pub trait Piecewise<const N: usize>: System<N> {
     /// solution from (t0, y0). The solver then takes no steps in the piece; it follows the
     /// solution and finds where it leaves the piece by a root search on it (see `passage`).
     /// The system may keep what the solution's points share, for the next call from the
-    /// same start. None (the default): the piece is crossed by steps.
+    /// same start. None (the default): the piece is crossed by steps. The passage watches
+    /// guard 0 only: a system with several guards returns None.
     fn exact(&mut self, _t0: f64, _y0: &[f64; N]) -> Option<impl ClosedForm<N>> {
         None::<NoClosedForm>
     }
@@ -120,21 +140,25 @@ pub trait Piecewise<const N: usize>: System<N> {
     /// taken here.
     fn observe<D: Dense<N>>(&mut self, _t0: f64, _h: f64, _step: &D) {}
 
-    /// Moves to the piece that contains `y[GUARD]` through each edge on the way (after a
+    /// Moves every guard to the piece that contains it through each edge on the way (after a
     /// jump of the state from outside the integrator); returns how many edges were crossed.
     fn settle(&mut self, t: f64, y: &[f64; N]) -> usize {
         let mut crossed = 0;
-        loop {
-            let (lo, hi) = self.piece();
-            let edge = if y[Self::GUARD] < lo {
-                Edge::Lower
-            } else if y[Self::GUARD] > hi {
-                Edge::Upper
-            } else {
-                return crossed;
-            };
-            self.cross(edge, t, y);
-            crossed += 1;
+        for guard in 0..self.guards() {
+            let g = y[Self::guard(guard).0];
+            loop {
+                let (lo, hi) = self.piece(guard);
+                let edge = if g < lo {
+                    Edge::Lower
+                } else if g > hi {
+                    Edge::Upper
+                } else {
+                    break;
+                };
+                self.cross(Crossing { guard, edge }, t, y);
+                crossed += 1;
+            }
         }
+        crossed
     }
 }

@@ -4,8 +4,8 @@
 //! passage from one call to the next so that the trajectory does not depend on the end
 //! times asked for.
 //!
-//! The search: from a point where the guard g = y[GUARD] lies at distances d_lo, d_hi from
-//! the piece's bounds and moves at v = y[RATE], with |g''| ≤ M along the solution, g cannot
+//! The search watches guard 0 of the system ([`Piecewise::guard`]): from a point where the
+//! guard g lies at distances d_lo, d_hi from the piece's bounds and moves at its rate v, with |g''| ≤ M along the solution, g cannot
 //! reach a bound before the time s at which d − w s − M s²/2 = 0 (w = the speed towards it),
 //! so the search jumps there, re-evaluates, and repeats. Towards a crossing at speed w the
 //! distance left falls as M d² / w² (quadratic convergence); the crossing is declared when the
@@ -25,7 +25,7 @@ pub(super) struct Passage<const N: usize> {
     pub t0: f64,
     #[serde(with = "super::serde_array")]
     pub y0: [f64; N],
-    /// Bound on |y[GUARD]''| from t0 on.
+    /// Bound on |g''| from t0 on (g: guard 0).
     bound: f64,
     pub t_clear: f64,
     #[serde(with = "super::serde_array")]
@@ -54,7 +54,7 @@ impl<const N: usize> Passage<N> {
         self.left_off.continued_by(t, y)
     }
 
-    /// Extends the search along `exact` through the piece [lo, hi] of `S`'s guard until it
+    /// Extends the search along `exact` through the piece [lo, hi] of `S`'s guard 0 until it
     /// is clear past t_end or has found the exit; returns the number of evaluations of the
     /// exact solution, or None if it needed more than `max_exit_evals` (a guard creeping
     /// along a bound). The exit is declared within `tol` of a bound.
@@ -67,7 +67,8 @@ impl<const N: usize> Passage<N> {
     ) -> Option<u64> {
         let mut evals = 0;
         while self.exit.is_none() && self.t_clear < t_end {
-            let (g, v) = (self.y_clear[S::GUARD], self.y_clear[S::RATE]);
+            let (guard, rate) = S::guard(0);
+            let (g, v) = (self.y_clear[guard], self.y_clear[rate]);
             let (d_lo, d_hi) = ((g - lo).max(0.0), (hi - g).max(0.0));
             if d_lo <= tol && v <= 0.0 {
                 self.exit = Some(Edge::Lower);
@@ -152,12 +153,13 @@ mod tests {
     }
 
     impl Piecewise<2> for Swing {
-        const GUARD: usize = 0;
-        const RATE: usize = 1;
-        fn piece(&self) -> (f64, f64) {
+        fn guard(_: usize) -> (usize, usize) {
+            (0, 1)
+        }
+        fn piece(&self, _: usize) -> (f64, f64) {
             PIECE
         }
-        fn cross(&mut self, _: Edge, _: f64, _: &[f64; 2]) {}
+        fn cross(&mut self, _: crate::integrator::Crossing, _: f64, _: &[f64; 2]) {}
     }
 
     impl ClosedForm<2> for Swing {

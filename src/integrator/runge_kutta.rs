@@ -11,9 +11,9 @@ use super::dopri5::{self, EVALS_PER_STEP};
 use super::entries::{Entries, Entry};
 use super::options::OPTIONS;
 use super::radau5::{Jacobian, RadauTrial, Stepper};
-use super::solver::{Budget, SolverError, Stats, locate_edge};
+use super::solver::{Budget, SolverError, Stats, locate_crossing};
 use super::stiffness::{Switch, spectral_radius, stiffness};
-use super::{Dense, Edge, Piecewise, System};
+use super::{Crossing, Dense, Piecewise, System};
 
 /// Which method steps (the FMU's `solver` parameter).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -42,7 +42,7 @@ pub(super) struct Accepted<const N: usize> {
     pub y1: [f64; N],
     h_next: f64,
     /// The edge the step leaves its piece through, and at which fraction of the step.
-    pub edge: Option<(Edge, f64)>,
+    pub edge: Option<(Crossing, f64)>,
     /// DOPRI5's stiffness estimate h·ρ of the step (0 when not asked for).
     h_rho: f64,
 }
@@ -142,7 +142,7 @@ impl<const N: usize> RungeKutta<N> {
         // flight or the contact before it left), else the step carried over the edge.
         let entering = match self.entering.take() {
             Some(entry) if self.mode == Mode::Dopri5 => {
-                let rate = y[S::RATE].abs();
+                let rate = y[S::guard(entry.through.guard).1].abs();
                 let width = entry.hi - entry.lo;
                 let base = if width.is_finite() && rate > 0.0 {
                     width / rate
@@ -155,12 +155,11 @@ impl<const N: usize> RungeKutta<N> {
             _ => None,
         };
         let (h, last) = budget.step(t, t_end, self.h, past)?;
-        let piece = sys.piece();
         let (verdict, y1, edge, h_rho) = match self.mode {
             Mode::Radau => {
                 let trial = self.implicit_step(sys, (t, y, &k1), h, stats);
                 let verdict = self.radau.judge(&trial);
-                let edge = verdict.accept.then(|| observed(sys, (t, h), &trial, piece));
+                let edge = verdict.accept.then(|| observed(sys, (t, h), &trial));
                 (verdict, trial.y1, edge, 0.0)
             }
             Mode::Dopri5 => {
@@ -170,9 +169,7 @@ impl<const N: usize> RungeKutta<N> {
                     err *= OPTIONS.first_step_distrust;
                 }
                 let verdict = self.controller.judge(err, h);
-                let edge = verdict
-                    .accept
-                    .then(|| observed(sys, (t, h), &*trial, piece));
+                let edge = verdict.accept.then(|| observed(sys, (t, h), &*trial));
                 let auto = verdict.accept && self.method == Method::Auto;
                 (
                     verdict,
@@ -328,16 +325,15 @@ impl<const N: usize> RungeKutta<N> {
     }
 }
 
-/// An accepted step from t of length h, shown to the system ([`Piecewise::observe`]): the edge of
-/// `piece` it leaves through, if any.
+/// An accepted step from t of length h, shown to the system ([`Piecewise::observe`]): the
+/// earliest edge it leaves its piece through, if any.
 fn observed<S: Piecewise<N>, D: Dense<N>, const N: usize>(
     sys: &mut S,
     (t, h): (f64, f64),
     step: &D,
-    (lo, hi): (f64, f64),
-) -> Option<(Edge, f64)> {
+) -> Option<(Crossing, f64)> {
     sys.observe(t, h, step);
-    locate_edge(step, (S::GUARD, S::RATE), lo, hi)
+    locate_crossing(sys, step)
 }
 
 /// A DOPRI5 trial from (t, y, f(t, y)) into `trial`, with its work counted.

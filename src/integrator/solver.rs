@@ -20,7 +20,7 @@ use super::passage::{self, Passage};
 use super::radau5::Jacobian;
 use super::roots::illinois;
 use super::runge_kutta::{Accepted, Mode, RungeKutta};
-use super::{Dense, Edge, Piecewise, taylor};
+use super::{Crossing, Dense, Edge, Piecewise, taylor};
 use serde::{Deserialize, Serialize};
 
 pub use super::runge_kutta::Method;
@@ -174,7 +174,7 @@ struct Ahead<const N: usize> {
     #[serde(with = "super::serde_array")]
     y1: [f64; N],
     /// The edge the step ends on, to be crossed when a call goes past it.
-    edge: Option<Edge>,
+    edge: Option<Crossing>,
     /// What the caller was given last.
     left_off: LeftOff<N>,
 }
@@ -386,13 +386,13 @@ impl<const N: usize> Solver<N> {
             _ => None,
         };
         let (t0, y0) = continued.map_or((*t, *y), |p| (p.t0, p.y0));
-        let piece = sys.piece();
+        let piece = sys.piece(0);
         let Some(exact) = sys.exact(t0, &y0) else {
             return Ok(None);
         };
         let mut passage = continued.unwrap_or_else(|| Passage::new(t0, &y0, &exact));
         self.kept = None;
-        let tol = passage::exit_tolerance(piece, self.tol.atol[S::GUARD]);
+        let tol = passage::exit_tolerance(piece, self.tol.atol[S::guard(0).0]);
         let evals = passage
             .search::<S>(&exact, piece, t_end, tol)
             .ok_or(SolverError::SearchStalled { t: *t })?;
@@ -402,7 +402,7 @@ impl<const N: usize> Solver<N> {
             Some(edge) if passage.t_clear <= t_end => {
                 *t = passage.t_clear;
                 *y = passage.y_clear;
-                self.cross(sys, edge, *t, y);
+                self.cross(sys, Crossing { guard: 0, edge }, *t, y);
                 Ok(Some(Flow::Go))
             }
             _ => {
@@ -437,10 +437,7 @@ impl<const N: usize> Solver<N> {
         trial: &mut dopri5::Trial<N>,
     ) -> Result<Flow, SolverError> {
         let (h, y1, edge) = match step {
-            Taken::Series(s, _) => {
-                let (lo, hi) = sys.piece();
-                (s.h, s.y1, locate_edge(*s, (S::GUARD, S::RATE), lo, hi))
-            }
+            Taken::Series(s, _) => (s.h, s.y1, locate_crossing(sys, *s)),
             Taken::RungeKutta(a) => (a.h, a.y1, a.edge),
         };
         let work = (&self.tol, &mut self.stats);
@@ -504,9 +501,9 @@ impl<const N: usize> Solver<N> {
 
     /// Crosses `edge` at (t, y): the system changes piece, and what was known of the old one
     /// goes.
-    fn cross<S: Piecewise<N>>(&mut self, sys: &mut S, edge: Edge, t: f64, y: &[f64; N]) {
+    fn cross<S: Piecewise<N>>(&mut self, sys: &mut S, edge: Crossing, t: f64, y: &[f64; N]) {
         sys.cross(edge, t, y);
-        let (lo, hi) = sys.piece();
+        let (lo, hi) = sys.piece(edge.guard);
         self.rk.entered(Entry {
             lo,
             hi,
@@ -523,7 +520,7 @@ impl<const N: usize> Solver<N> {
         dense: Interpolant<N>,
         h: f64,
         y1: [f64; N],
-        edge: Option<Edge>,
+        edge: Option<Crossing>,
         (t, y): (&mut f64, &mut [f64; N]),
         t_end: f64,
     ) {
@@ -540,7 +537,26 @@ impl<const N: usize> Solver<N> {
     }
 }
 
-/// Whether the accepted trial leaves [lo, hi] on its guard component, and where: the edge and
+/// The earliest edge that the accepted step leaves its piece through, among all guards of
+/// `sys`, and the fraction θ of the step at which it does (each guard located by
+/// [`locate_edge`]; a tie goes to the lower guard).
+pub(crate) fn locate_crossing<S: Piecewise<N>, T: Dense<N>, const N: usize>(
+    sys: &S,
+    step: &T,
+) -> Option<(Crossing, f64)> {
+    let mut first: Option<(Crossing, f64)> = None;
+    for guard in 0..sys.guards() {
+        let (lo, hi) = sys.piece(guard);
+        if let Some((edge, theta)) = locate_edge(step, S::guard(guard), lo, hi)
+            && first.is_none_or(|(_, earliest)| theta < earliest)
+        {
+            first = Some((Crossing { guard, edge }, theta));
+        }
+    }
+    first
+}
+
+/// Whether the accepted trial leaves [lo, hi] on a guard component, and where: the edge and
 /// the fraction θ of the step at which the dense output first reaches it. The rate of the
 /// guard tells the shape of the trajectory inside the step: moving out then back in (a graze,
 /// decided by the extremum, so it is not skipped), moving in then out (the exit can only come

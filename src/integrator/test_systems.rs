@@ -1,7 +1,7 @@
 //! Systems with known solutions for the integrator's unit tests: a smooth nonlinear one, a
 //! stiff linear one, Robertson's kinetics, and a mass bouncing on a stiff contact.
 
-use super::{Edge, Jacobian, Piecewise, System, Tolerance};
+use super::{Crossing, Jacobian, Piecewise, System, Tolerance};
 
 /// Tolerance with all components controlled.
 pub(crate) fn tolerance<const N: usize>(rtol: f64, atol: [f64; N]) -> Tolerance<N> {
@@ -24,12 +24,13 @@ pub(crate) fn sci(v: &[f64]) -> String {
 macro_rules! smooth {
     ($t:ty, $n:literal) => {
         impl Piecewise<$n> for $t {
-            const GUARD: usize = 0;
-            const RATE: usize = 0;
-            fn piece(&self) -> (f64, f64) {
+            fn guard(_: usize) -> (usize, usize) {
+                (0, 0)
+            }
+            fn piece(&self, _: usize) -> (f64, f64) {
                 (f64::NEG_INFINITY, f64::INFINITY)
             }
-            fn cross(&mut self, _: Edge, _: f64, _: &[f64; $n]) {}
+            fn cross(&mut self, _: Crossing, _: f64, _: &[f64; $n]) {}
         }
     };
 }
@@ -151,16 +152,17 @@ impl Jacobian<2> for Bounce {
     }
 }
 impl Piecewise<2> for Bounce {
-    const GUARD: usize = 0;
-    const RATE: usize = 1;
-    fn piece(&self) -> (f64, f64) {
+    fn guard(_: usize) -> (usize, usize) {
+        (0, 1)
+    }
+    fn piece(&self, _: usize) -> (f64, f64) {
         if self.contact {
             (f64::NEG_INFINITY, 0.0)
         } else {
             (0.0, f64::INFINITY)
         }
     }
-    fn cross(&mut self, _: Edge, _: f64, _: &[f64; 2]) {
+    fn cross(&mut self, _: Crossing, _: f64, _: &[f64; 2]) {
         self.contact = !self.contact;
     }
 }

@@ -108,7 +108,7 @@ impl Dynamics {
 
     /// The loose gear's response to the contact force and the shaft's motion (MODEL.md §3).
     #[inline]
-    fn respond(&self, force: ContactForce, xi_dot: f64, shaft: &Shaft) -> Loads {
+    pub fn respond(&self, force: ContactForce, xi_dot: f64, shaft: &Shaft) -> Loads {
         let p = &self.params;
         let omega_L = (xi_dot + p.r_M * shaft.omega) * self.inv_r_L;
         let alpha_L = (p.B - p.r_L * force.total() - p.C * (omega_L - p.omega_S)) * self.inv_I_L;
