@@ -8,6 +8,8 @@ PYTHON ?= python3
 VENV := .venv
 PY := $(VENV)/bin/python
 FMU := target/fmu/GearRattle.fmu
+# The same binaries with the FMI 3.0 model description (fmi3-shell's exports).
+FMU3 := target/fmu/fmi3/GearRattle.fmu
 LIB := target/release/libgear_rattle.so
 # The FMU's binaries as built (with line tables, for debugging) and as packaged (stripped).
 FMU_DEBUG := target/fmu/debug
@@ -24,13 +26,16 @@ all: fmu
 # Included before the rules so that the fragments' prerequisites are seen.
 include $(wildcard mk/*.mk)
 
-## fmu: build target/fmu/GearRattle.fmu (linux64, darwin64, win64)
-fmu: $(FMU)
+## fmu: build target/fmu/GearRattle.fmu (FMI 2.0) and target/fmu/fmi3/GearRattle.fmu (FMI 3.0), linux64, darwin64, win64
+fmu: $(FMU) $(FMU3)
 
 # The fragments build the binaries and name them in PACKAGE_FLAGS: mk/portable.mk linux64
 # (for glibc 2.17) and darwin64 with zig, mk/windows.mk win64.
 $(FMU): $(FMU_DEPS) $(wildcard packaging/src/*.rs packaging/src/bin/*.rs) | libclang
 	cargo run --release --quiet -p packaging --bin package -- --model GearRattle $(PACKAGE_FLAGS) --out $(FMU)
+
+$(FMU3): $(FMU_DEPS) $(wildcard packaging/src/*.rs packaging/src/bin/*.rs) | libclang
+	cargo run --release --quiet -p packaging --bin package -- --model GearRattle --fmi 3 $(PACKAGE_FLAGS) --out $(FMU3)
 
 # The native library, loaded by the C-API tests (the FMU's linux64 binary is built by
 # mk/portable.mk). cargo decides what to rebuild; this rule always asks it.
@@ -47,9 +52,9 @@ demo: fmu $(VENV)/.installed
 test: $(TEST_TARGETS)
 
 # The C-API tests load the cdylib, which `cargo test` alone does not produce. fmi2-shell's
-# own tests check FMI's rules on a model of their own.
+# own tests check FMI's rules on a model of their own, fmi3-shell's its state table.
 test-rust: $(LIB) | libclang
-	cargo test --release -p gear_rattle -p fmi2-shell
+	cargo test --release -p gear_rattle -p fmi2-shell -p fmi3-shell
 
 test-python: fmu $(VENV)/.installed
 	$(PY) -m pytest -q

@@ -65,7 +65,7 @@ pub struct Options {
     /// within DOPRI5's stability that make it non-stiff again: 5, not Hairer's 15, because
     /// a gear pair's stiff phases are short (a contact between two impacts) and each verdict
     /// waited for costs a step bounded by stability (or a short implicit one); S1 (never
-    /// stiff) is not handed over either way (docs/DECISIONS.md, D36).
+    /// stiff) is not handed over either way (docs/DECISIONS.md, D38).
     pub stiff_steps: u32,
     /// Non-stiff verdicts in a row that restart the count of stiff ones (Hairer's 6).
     pub calm_steps: u32,
