@@ -6,9 +6,12 @@
 use serde::{Deserialize, Serialize};
 
 use crate::contract::{self, Causality, Kind, LOG_CATEGORIES, VARIABLES, vr};
+use crate::model_exchange::{NX, NZ};
 use crate::simulation::{self, Simulation};
 use fmi2_shell::values::Values;
-use fmi2_shell::{FmiError, FmiResult, FmiState, Identity, Interface, Log, Slave, Status};
+use fmi2_shell::{
+    EventInfo, FmiError, FmiResult, FmiState, Identity, Interface, Log, Slave, Status,
+};
 
 /// The contract's log categories by role (errors and warnings first, as the shell wants).
 const EVENTS: usize = contract::log::logEvents;
@@ -34,7 +37,8 @@ pub struct Instance {
 impl Instance {
     fn build(&self) -> FmiResult<Simulation> {
         let rtol = self.tolerance.unwrap_or(contract::DEFAULT_TOLERANCE);
-        Simulation::new(&self.values, self.start_time, rtol)
+        let model_exchange = self.interface == Interface::ModelExchange;
+        Simulation::new(&self.values, self.start_time, rtol, model_exchange)
     }
 
     /// The running simulation, or during initialisation one built from the values so far.
@@ -63,9 +67,15 @@ impl Instance {
         );
         let omega_out = values.real(vr::omega_out);
         let sim = self.sim_mut();
-        if drive {
-            sim.set_flywheel(flywheel);
-            sim.set_input_side(input_side);
+        match state {
+            FmiState::EventMode | FmiState::ContinuousTimeMode if drive => {
+                sim.set_drive_inputs(flywheel, input_side);
+            }
+            _ if drive => {
+                sim.set_flywheel(flywheel);
+                sim.set_input_side(input_side);
+            }
+            _ => {}
         }
         if output_speed {
             sim.set_output_speed(omega_out);
@@ -140,6 +150,31 @@ impl Instance {
     }
 }
 
+/// Copies a vector of the model into the importer's array, refused if the lengths differ;
+/// a value that overflowed is fmi2Discard, which asks the importer for a smaller step.
+fn fill<const K: usize>(what: &str, out: &mut [f64], value: [f64; K]) -> FmiResult {
+    length(what, out.len(), K)?;
+    if let Some(bad) = value.iter().position(|v| !v.is_finite()) {
+        return Err(FmiError::discard(format!(
+            "{what}[{bad}] = {} at these states and time: beyond what the model can represent; take a smaller step",
+            value[bad]
+        )));
+    }
+    out.copy_from_slice(&value);
+    Ok(())
+}
+
+/// Checks the length of an importer's vector.
+fn length(what: &str, n: usize, expected: usize) -> FmiResult {
+    if n == expected {
+        Ok(())
+    } else {
+        Err(FmiError::error(format!(
+            "{what} has {n} elements: the model has {expected}"
+        )))
+    }
+}
+
 impl Slave for Instance {
     const IDENTITY: Identity = Identity {
         guid: contract::GUID,
@@ -147,7 +182,7 @@ impl Slave for Instance {
         log_categories: LOG_CATEGORIES,
         state_magic: *b"GBXS",
         state_version: 1,
-        model_exchange: false,
+        model_exchange: true,
         variable: contract::variable,
     };
 
@@ -275,6 +310,62 @@ impl Slave for Instance {
                 "fmi2DoStep from t = {current} to {t_end} failed: {e}; the state stays at t = {current}"
             ))),
         }
+    }
+
+    // Model Exchange (see `crate::model_exchange`).
+
+    fn set_time(&mut self, t: f64) -> FmiResult {
+        self.sim_mut().set_time(t);
+        Ok(())
+    }
+
+    fn set_continuous_states(&mut self, x: &[f64]) -> FmiResult {
+        length("x", x.len(), NX)?;
+        if let Some(bad) = x.iter().position(|v| !v.is_finite()) {
+            return Err(FmiError::error(format!(
+                "x[{bad}] = {} refused: the continuous states must be finite",
+                x[bad]
+            )));
+        }
+        self.sim_mut()
+            .set_continuous_states(x.try_into().expect("length checked"));
+        Ok(())
+    }
+
+    fn get_continuous_states(&mut self, x: &mut [f64]) -> FmiResult {
+        fill("x", x, self.current()?.continuous_states())
+    }
+
+    fn get_nominals_of_continuous_states(&mut self, x: &mut [f64]) -> FmiResult {
+        fill("x_nominal", x, self.current()?.nominals())
+    }
+
+    fn get_derivatives(&mut self, dx: &mut [f64]) -> FmiResult {
+        fill("derivatives", dx, self.current()?.derivatives())
+    }
+
+    fn get_event_indicators(&mut self, z: &mut [f64]) -> FmiResult {
+        length("eventIndicators", z.len(), NZ)?;
+        fill("eventIndicators", z, self.current()?.event_indicators())
+    }
+
+    fn new_discrete_states(&mut self) -> FmiResult<EventInfo> {
+        let sim = self.sim.as_ref().expect("initialised");
+        let t = sim.t;
+        let before = Self::events(sim);
+        let next_event_time = self.sim_mut().update_discrete_states();
+        if self.log.is_on(EVENTS) {
+            self.log_events(t, before);
+        }
+        Ok(EventInfo {
+            next_event_time,
+            ..EventInfo::default()
+        })
+    }
+
+    fn completed_integrator_step(&mut self) -> FmiResult<bool> {
+        self.sim_mut().completed_integrator_step();
+        Ok(false)
     }
 
     /// A decoded state must be one this build can run: an initialised instance has its

@@ -13,14 +13,14 @@ use gear_rattle::rattle::window::Metrics;
 /// What the outputs are computed from now.
 struct Now<'a> {
     sim: &'a Simulation,
-    gearbox: &'a Gearbox,
+    gearbox: Gearbox,
     y: State,
     readout: Readout,
 }
 
 impl<'a> Now<'a> {
     fn new(sim: &'a Simulation) -> Self {
-        let (gearbox, y) = sim.gearbox();
+        let (gearbox, y) = sim.observed();
         Now {
             sim,
             gearbox,

@@ -67,6 +67,9 @@ pub struct Simulation {
     /// Communication points served from the dense output of natural steps (the built-in
     /// engine's drive does not change between steps; inputs do).
     interpolate_ends: bool,
+    /// Model Exchange: the importer integrates, the outputs take the pieces the states are
+    /// in.
+    pub model_exchange: bool,
 }
 
 /// The gearbox's parameters as set: gears 1..n_gears from the per-gear arrays (C and c_I at
@@ -185,9 +188,15 @@ impl Simulation {
     /// Checks the parameters (the contract's ranges, then GEARBOX.md's rules between them)
     /// and builds GEARBOX.md §6's start at t0 with φ(0) = phi_start and each
     /// ξ_i(0) = gap_start_i G_i, the output shaft at omega_out.
-    pub fn new(values: &Values, t0: f64, rtol: f64) -> FmiResult<Self> {
+    pub fn new(values: &Values, t0: f64, rtol: f64, model_exchange: bool) -> FmiResult<Self> {
         contract::check_parameters(values)?;
         let params = params(values);
+        if model_exchange && params.engine.rpm_rate != 0.0 {
+            return Err(FmiError::error(format!(
+                "rpm_rate = {:e} refused in Model Exchange: the ramped engine's angle and speed are states of co-simulation only; set rpm_rate = 0 or use Co-Simulation",
+                params.engine.rpm_rate
+            )));
+        }
         let drive = drive(values, &params, t0);
         let (_, mut y) = Gearbox::start(&params, drive)
             .map_err(|e| FmiError::error(format!("{e}: nothing runs on an invalid gearbox")))?;
@@ -210,6 +219,7 @@ impl Simulation {
             rtol,
             method,
             interpolate_ends,
+            model_exchange,
         };
         if sim.window_from <= t0 {
             sim.open_window();
@@ -219,7 +229,7 @@ impl Simulation {
 
     /// The statistics window opens now: the windowed gearbox takes over from the lean one
     /// with a solver of its own size.
-    fn open_window(&mut self) {
+    pub(crate) fn open_window(&mut self) {
         let Run::Lean(k) = &self.run else {
             return;
         };
@@ -253,6 +263,16 @@ impl Simulation {
         on_run!(&mut self.run, k => k.advance_to(&mut self.t, t_end))
     }
 
+    /// The gearbox and its state now, as the outputs read them: in Model Exchange with the
+    /// stage and regions the states are in.
+    pub fn observed(&self) -> (Gearbox, State) {
+        if self.model_exchange {
+            return self.settled();
+        }
+        let (g, y) = self.gearbox();
+        (*g, y)
+    }
+
     /// The gearbox and its state now.
     pub fn gearbox(&self) -> (&Gearbox, State) {
         match &self.run {
@@ -271,7 +291,7 @@ impl Simulation {
 
     /// Changes the gearbox and its state from outside (new inputs): `change` gets the
     /// gearbox, the time and the gearbox's state; the solver starts afresh.
-    fn change(&mut self, change: impl FnOnce(&mut Gearbox, f64, &mut State)) {
+    pub(crate) fn change_state(&mut self, change: impl FnOnce(&mut Gearbox, f64, &mut State)) {
         let t = self.t;
         match &mut self.run {
             Run::Lean(k) => {
@@ -290,7 +310,7 @@ impl Simulation {
     /// New flywheel inputs (excitation 0; ignored otherwise): φ and φ' follow at once.
     pub fn set_flywheel(&mut self, shaft: Shaft) {
         if matches!(self.gearbox().0.drive, Drive::Flywheel(_)) {
-            self.change(|g, t, y| {
+            self.change_state(|g, t, y| {
                 g.set_flywheel(t, y, shaft);
             });
         }
@@ -299,7 +319,7 @@ impl Simulation {
     /// New input-side inputs (excitation 2; ignored otherwise): the ξ_i follow at once.
     pub fn set_input_side(&mut self, shaft: Shaft) {
         if matches!(self.gearbox().0.drive, Drive::InputSide(_)) {
-            self.change(|g, t, y| {
+            self.change_state(|g, t, y| {
                 g.set_input_side(t, y, shaft);
             });
         }
@@ -307,7 +327,7 @@ impl Simulation {
 
     /// The output shaft's speed.
     pub fn set_output_speed(&mut self, omega_out: f64) {
-        self.change(|g, _, _| g.set_output_speed(omega_out));
+        self.change_state(|g, _, _| g.set_output_speed(omega_out));
     }
 
     /// The imposed motion's extrapolation now (excitation 0: the flywheel's, 2: the input

@@ -59,6 +59,16 @@ impl Windowed {
         }
     }
 
+    /// Each gear's |a| at (t, y) for its window's peak.
+    pub fn sample_accelerations(&mut self, t: f64, y: &State) {
+        let accelerations = self.accelerations(t, y);
+        for (window, a) in self.windows.iter_mut().zip(accelerations) {
+            if let Some(a) = a {
+                window.acceleration(t, a);
+            }
+        }
+    }
+
     /// Each gear's pitch-line acceleration |r_L α_L| at (t, y), for the gears whose ξ lies
     /// in its current piece (a point past an edge is not the piece's).
     fn accelerations(&self, t: f64, y: &State) -> [Option<f64>; MAX_GEARS] {
@@ -151,13 +161,7 @@ impl Piecewise<N> for Windowed {
     fn observe<D: Dense<N>>(&mut self, t0: f64, h: f64, step: &D) {
         for theta in [0.5, 1.0] {
             let y: State = std::array::from_fn(|k| step.dense(k, theta));
-            let t = t0 + theta * h;
-            let accelerations = self.accelerations(t, &y);
-            for (window, a) in self.windows.iter_mut().zip(accelerations) {
-                if let Some(a) = a {
-                    window.acceleration(t, a);
-                }
-            }
+            self.sample_accelerations(t0 + theta * h, &y);
         }
     }
 }
