@@ -60,9 +60,12 @@ demo: fmu $(VENV)/.installed
 test: $(TEST_TARGETS)
 
 # The C-API tests load the cdylib, which `cargo test` alone does not produce. fmi2-shell's
-# own tests check FMI's rules on a model of their own.
+# own tests check FMI's rules on a model of their own. The gearbox's crate is tested on its
+# own: built with gear_rattle in one cargo call, gear_rattle's `fmu` feature (its fmi2*
+# exports) would be on for the gearbox too, whose own exports would then clash with them.
 test-rust: $(LIB) | libclang
 	cargo test --release -p gear_rattle -p fmi2-shell
+	cargo test --release -p gearbox_rattle
 
 test-python: fmu $(VENV)/.installed
 	$(PY) -m pytest -q

@@ -35,6 +35,11 @@ pub struct Instance {
 }
 
 impl Instance {
+    /// The running gearbox, once initialised.
+    pub fn simulation(&self) -> Option<&Simulation> {
+        self.sim.as_ref()
+    }
+
     fn build(&self) -> FmiResult<Simulation> {
         let rtol = self.tolerance.unwrap_or(contract::DEFAULT_TOLERANCE);
         let model_exchange = self.interface == Interface::ModelExchange;

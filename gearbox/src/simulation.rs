@@ -47,16 +47,17 @@ impl<S: Piecewise<N> + Jacobian<N> + Copy, const N: usize> Stepped<S, N> {
     }
 }
 
-/// The gearbox before its statistics window opens, and with it.
-#[allow(clippy::large_enum_variant)]
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+/// The gearbox before its statistics window opens, and with it. Boxed: their solvers are
+/// some 60 and 145 KB, which an instance, its FMU states and their decoding keep off the
+/// stack (an importer's thread may have 1 MB).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub enum Run {
-    Lean(Stepped<Gearbox, { gearbox::N }>),
-    Windowed(Stepped<Windowed, { windowed::N }>),
+    Lean(Box<Stepped<Gearbox, { gearbox::N }>>),
+    Windowed(Box<Stepped<Windowed, { windowed::N }>>),
 }
 
 /// An initialised gearbox being stepped.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Simulation {
     pub run: Run,
     pub t: f64,
@@ -213,7 +214,7 @@ impl Simulation {
         let mut solver = Solver::with_method(system.tolerance(rtol), method);
         solver.interpolate_ends = interpolate_ends;
         let mut sim = Simulation {
-            run: Run::Lean(Stepped { system, solver, y }),
+            run: Run::Lean(Box::new(Stepped { system, solver, y })),
             t: t0,
             window_from: values.real(vr::stats_from).max(t0),
             rtol,
@@ -237,19 +238,19 @@ impl Simulation {
         let mut solver = Solver::with_method(system.tolerance(self.rtol), self.method);
         solver.interpolate_ends = self.interpolate_ends;
         solver.stats = k.solver.stats;
-        self.run = Run::Windowed(Stepped { system, solver, y });
+        self.run = Run::Windowed(Box::new(Stepped { system, solver, y }));
     }
 
     /// Advances to t_end, through the window's opening on the way. On failure the
     /// simulation is left as it was.
     pub fn step_to(&mut self, t_end: f64) -> Result<(), SolverError> {
         if matches!(self.run, Run::Lean(_)) && self.window_from <= t_end {
-            let before = Box::new(*self);
+            let before = self.clone();
             let opened = self
                 .advance_to(self.window_from)
                 .map(|()| self.open_window());
             if let Err(e) = opened.and_then(|()| self.advance_to(t_end)) {
-                *self = *before;
+                *self = before;
                 return Err(e);
             }
         } else {
