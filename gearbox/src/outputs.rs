@@ -7,14 +7,13 @@ use crate::contract::vr::{self, gear::offset};
 use crate::contract::{DERIVATIVES, STATES};
 use crate::simulation::Simulation;
 use crate::windowed;
-use gear_rattle::gearbox::{Gearbox, Readout, State};
+use gear_rattle::gearbox::{Gearbox, Readout};
 use gear_rattle::rattle::window::Metrics;
 
 /// What the outputs are computed from now.
 struct Now<'a> {
     sim: &'a Simulation,
     gearbox: Gearbox,
-    y: State,
     readout: Readout,
 }
 
@@ -23,9 +22,8 @@ impl<'a> Now<'a> {
         let (gearbox, y) = sim.observed();
         Now {
             sim,
-            gearbox,
-            y,
             readout: gearbox.readout(sim.t, &y),
+            gearbox,
         }
     }
 
