@@ -179,3 +179,28 @@ fn inputs_drive_the_box_as_the_engine_does() {
         assert!(tau != 0.0);
     });
 }
+
+/// Corrupt bytes are refused by the envelope's checksum; a state made by hand with a valid
+/// checksum is refused when the instance could not run (here: in a state of the other
+/// interface).
+#[test]
+fn corrupt_or_inconsistent_states_are_refused() {
+    with_stack(|| {
+        let mut i = initialised(&[]);
+        run(&mut i, 0.0, 0.002, 1e-3);
+        let mut bytes = serialize(&i);
+        bytes[20] ^= 1;
+        let refused = deserialize::<Instance>(&bytes).unwrap_err().message;
+        assert!(refused.contains("checksum"), "{refused}");
+        let stepping = serialize(&i);
+        let mut me = deserialize::<Instance>(&stepping).unwrap();
+        me.state = FmiState::EventMode;
+        let refused = deserialize::<Instance>(&serialize(&me))
+            .unwrap_err()
+            .message;
+        assert!(
+            refused.contains("CoSimulation instance in state EventMode"),
+            "{refused}"
+        );
+    });
+}
