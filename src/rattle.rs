@@ -300,11 +300,11 @@ pub(crate) fn step_peak<S: GearPair<N>, D: Dense<N>, const N: usize>(
 
 /// Vertices of successive parabolas tried per step: each adds about three correct digits to
 /// the peak's position near a smooth maximum.
-const PEAK_ITERATIONS: usize = 3;
+pub const PEAK_ITERATIONS: usize = 3;
 
 /// Where the parabola through three points (in increasing x) peaks, and its value there;
 /// None unless it opens downwards.
-fn parabola_peak(p: &[(f64, f64); 3]) -> Option<(f64, f64)> {
+pub fn parabola_peak(p: &[(f64, f64); 3]) -> Option<(f64, f64)> {
     let [(x0, y0), (x1, y1), (x2, y2)] = *p;
     let (s01, s12) = ((y1 - y0) / (x1 - x0), (y2 - y1) / (x2 - x1));
     let curvature = (s12 - s01) / (x2 - x0);
