@@ -276,11 +276,23 @@ pub(crate) fn step_peak<S: GearPair<N>, D: Dense<N>, const N: usize>(
         };
         return (first.max(a_end), a_end);
     }
-    let mut points = [(0.0, a0), (0.5, a_at(0.5)), (1.0, a_end)];
-    let mut peak = a0.max(points[1].1).max(a_end);
+    let points = [(0.0, a0), (0.5, a_at(0.5)), (1.0, a_end)];
+    (refine_peak(points, window.a_peak, a_at), a_end)
+}
+
+/// The largest of |a| at three points (θ, |a|) of a step, θ = 0, ½, 1, and of the values
+/// `a_at` gives where the parabola through the three around the largest so far peaks inside
+/// the step above both that largest and `floor` (the window's peak so far): successive
+/// parabolic interpolation, [`PEAK_ITERATIONS`] vertices at most.
+pub fn refine_peak(
+    mut points: [(f64, f64); 3],
+    floor: f64,
+    mut a_at: impl FnMut(f64) -> f64,
+) -> f64 {
+    let mut peak = points[0].1.max(points[1].1).max(points[2].1);
     for _ in 0..PEAK_ITERATIONS {
         let Some(theta) = parabola_peak(&points)
-            .filter(|&(x, y)| (0.0..=1.0).contains(&x) && y > peak.max(window.a_peak))
+            .filter(|&(x, y)| (0.0..=1.0).contains(&x) && y > peak.max(floor))
             .map(|(x, _)| x)
         else {
             break;
@@ -295,16 +307,16 @@ pub(crate) fn step_peak<S: GearPair<N>, D: Dense<N>, const N: usize>(
             .unwrap_or(1);
         points = [all[best - 1], all[best], all[best + 1]];
     }
-    (peak, a_end)
+    peak
 }
 
 /// Vertices of successive parabolas tried per step: each adds about three correct digits to
 /// the peak's position near a smooth maximum.
-pub const PEAK_ITERATIONS: usize = 3;
+const PEAK_ITERATIONS: usize = 3;
 
 /// Where the parabola through three points (in increasing x) peaks, and its value there;
 /// None unless it opens downwards.
-pub fn parabola_peak(p: &[(f64, f64); 3]) -> Option<(f64, f64)> {
+fn parabola_peak(p: &[(f64, f64); 3]) -> Option<(f64, f64)> {
     let [(x0, y0), (x1, y1), (x2, y2)] = *p;
     let (s01, s12) = ((y1 - y0) / (x1 - x0), (y2 - y1) / (x2 - x1));
     let curvature = (s12 - s01) / (x2 - x0);

@@ -11,8 +11,8 @@ use serde::{Deserialize, Serialize};
 use gear_rattle::gearbox::{self, Gearbox, MAX_GEARS, State, e_contact, e_lubricant, xi};
 use gear_rattle::integrator::{Crossing, Dense, Jacobian, Piecewise, System, Tolerance};
 use gear_rattle::physics::Region;
+use gear_rattle::rattle::refine_peak;
 use gear_rattle::rattle::window::{Quadratures, Window, quadrature};
-use gear_rattle::rattle::{PEAK_ITERATIONS, parabola_peak};
 
 /// The gearbox's state, then ∫a² dt, ∫F dt, ∫F² dt of each gear slot.
 pub const N: usize = gearbox::N + 3 * MAX_GEARS;
@@ -185,25 +185,8 @@ impl Piecewise<N> for Windowed {
             if self.inner.gears[i].region == Region::Gap {
                 continue;
             }
-            let mut points = [(0.0, a0), (0.5, mid[i]), (1.0, end[i])];
-            *peak = peak.max(mid[i]);
-            for _ in 0..PEAK_ITERATIONS {
-                let Some(theta) = parabola_peak(&points)
-                    .filter(|&(x, y)| (0.0..=1.0).contains(&x) && y > peak.max(window.a_peak))
-                    .map(|(x, _)| x)
-                else {
-                    break;
-                };
-                let value = a_at(theta)[i];
-                *peak = peak.max(value);
-                // The three points around the largest value so far bracket the next vertex.
-                let mut all = [points[0], points[1], points[2], (theta, value)];
-                all.sort_by(|p, q| p.0.total_cmp(&q.0));
-                let best = (1..3)
-                    .max_by(|&j, &k| all[j].1.total_cmp(&all[k].1))
-                    .unwrap_or(1);
-                points = [all[best - 1], all[best], all[best + 1]];
-            }
+            let points = [(0.0, a0), (0.5, mid[i]), (1.0, end[i])];
+            *peak = refine_peak(points, window.a_peak, |theta| a_at(theta)[i]);
         }
         let t = t0 + h;
         for ((window, peak), end) in self.windows.iter_mut().zip(peaks).zip(end) {
