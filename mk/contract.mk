@@ -1,7 +1,7 @@
 # The contracts (modelDescription/*.toml) and what is generated from them outside a build:
 # docs/PARAMETERS.md (tests/contract.rs checks that it is up to date), and the generator's own
 # tests (GearboxRattle's arrays, its Rust constants compiled in a crate of their own, both
-# model descriptions through fmpy's validate_fmu).
+# model descriptions, FMI 2.0 and FMI 3.0, through fmpy's validate_fmu).
 
 .PHONY: docs-parameters test-generator
 TEST_TARGETS += test-generator

@@ -1,13 +1,13 @@
 #!/usr/bin/env python3
 """Linker for the apple-darwin targets of `cargo zigbuild` (mk/portable.mk): hides every
-symbol but the fmi2* functions, then hands the link to cargo-zigbuild's `zig cc` wrapper.
+symbol but the fmi2* and fmi3* functions, then hands the link to cargo-zigbuild's `zig cc` wrapper.
 
 Why: rustc passes the Apple linker an exported-symbols list (every #[no_mangle] function,
 fmi-sys's `callback_log` included), but zig's Mach-O linker ignores -exported_symbols_list
 and exports every global symbol of its inputs (about 2 500 here, the Rust standard library's
 among them). It does honour private-extern symbols (N_PEXT, what visibility("hidden") makes),
 so this script copies each object and archive of the link, marks every symbol it defines that
-is not on rustc's list narrowed to fmi2* as private extern, and links the copies. The narrowed
+is not on rustc's list narrowed to fmi2* and fmi3* as private extern, and links the copies. The narrowed
 list is passed on too, for a linker that reads it. tests/portable/check.sh checks the dylib's
 export trie.
 
@@ -78,9 +78,9 @@ def main(args):
         fail("rustc's -exported_symbols_list is not among the arguments (is this a cdylib link?)")
     list_path = args[lists[0] + 1].removeprefix("-Wl,")
     with open(list_path) as f:
-        keep = [n.strip() for n in f if re.fullmatch(r"_fmi2\w+", n.strip())]
+        keep = [n.strip() for n in f if re.fullmatch(r"_fmi[23]\w+", n.strip())]
     if not keep:
-        fail(f"no fmi2* symbol in {list_path}")
+        fail(f"no fmi2* or fmi3* symbol in {list_path}")
     work = os.path.dirname(list_path)  # rustc's temporary directory for this link
     narrowed = os.path.join(work, "list.fmi2")
     with open(narrowed, "w") as f:

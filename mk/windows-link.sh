@@ -1,6 +1,6 @@
 #!/bin/sh
 # Linker for the x86_64-pc-windows-gnu target (set in .cargo/config.toml): MinGW-w64's gcc,
-# after narrowing rustc's export list to the fmi2* functions.
+# after narrowing rustc's export list to the fmi2* and fmi3* functions.
 #
 # Why: for a cdylib, rustc writes a .def file naming every #[no_mangle] symbol of every crate,
 # fmi-sys's `callback_log` included, and passes it to GNU ld as `-Wl,<tmpdir>/list.def`.
@@ -8,7 +8,7 @@
 # ld's PE back end has no such thing for .def exports: a second .def only adds to the list
 # (def files are merged), and --exclude-symbols / --exclude-all-symbols apply to automatic
 # exports only. So the one place to drop a name is the list itself: this script writes a
-# copy with only the fmi2* entries and links with that copy instead (rustc's file is left
+# copy with only the fmi2* and fmi3* entries and links with that copy instead (rustc's file is left
 # as it is). tests/windows/run.sh checks the resulting export table.
 set -eu
 
@@ -28,8 +28,8 @@ for arg in "$@"; do
             kept=${def%.def}.fmi2.def
             echo EXPORTS >"$kept"
             # An empty list would make ld export every global symbol: refuse instead.
-            if ! grep -E '^[[:space:]]*"?fmi2' "$def" >>"$kept"; then
-                echo "mk/windows-link.sh: no fmi2* symbol in $def" >&2
+            if ! grep -E '^[[:space:]]*"?fmi[23]' "$def" >>"$kept"; then
+                echo "mk/windows-link.sh: no fmi2* or fmi3* symbol in $def" >&2
                 exit 1
             fi
             case $arg in -Wl,*) arg=-Wl,$kept ;; *) arg=$kept ;; esac

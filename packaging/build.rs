@@ -1,4 +1,4 @@
-//! Build script: the model description and the variables of each FMU the packaging binary
+//! Build script: the model descriptions (FMI 2.0, FMI 3.0) and the variables of each FMU the packaging binary
 //! knows, from its contract by fmi2-shell's generator (the one the FMU's own build script
 //! runs, so that the XML packaged is the one its binary was built with), each into a folder of
 //! its own in OUT_DIR.
@@ -24,9 +24,12 @@ fn main() {
         let text = fs::read_to_string(contract).unwrap_or_else(|e| panic!("{contract}: {e}"));
         let (xml, rust) =
             fmi2_shell::build::outputs(&text).unwrap_or_else(|e| panic!("{contract}: {e}"));
+        let xml3 = fmi2_shell::build::fmi3_description(&text)
+            .unwrap_or_else(|e| panic!("{contract}: {e}"));
         let dir = out.join(model);
-        fs::create_dir_all(&dir).unwrap();
+        fs::create_dir_all(dir.join("fmi3")).unwrap();
         fs::write(dir.join("modelDescription.xml"), xml).unwrap();
+        fs::write(dir.join("fmi3/modelDescription.xml"), xml3).unwrap();
         fs::write(dir.join("contract.rs"), rust).unwrap();
     }
 }

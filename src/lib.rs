@@ -14,7 +14,8 @@
 //! - [`instance`]: the slave of fmi2-shell (variables, co-simulation stepping, Model
 //!   Exchange's states and events; the shell applies FMI's rules around it);
 //! - the `fmi2*` C exports of Co-Simulation and Model Exchange: [`fmi2_shell`]'s, around
-//!   [`instance::Instance`];
+//!   [`instance::Instance`], and the `fmi3*` ones of FMI 3.0 beside them ([`fmi3_shell`]'s,
+//!   around the same instance);
 //! - [`contract`]: value references and the model description, generated from
 //!   `modelDescription/GearRattle.toml` (packaged into the .fmu by the workspace's
 //!   `packaging` crate).
@@ -27,11 +28,14 @@ pub mod math;
 pub mod physics;
 pub mod rattle;
 
-/// Whether this build carries GearRattle's fmi2* exports (the default feature `fmu`): a
-/// library that links this crate for the model only (gearbox/) must be built without them.
+/// Whether this build carries GearRattle's fmi2* and fmi3* exports (the default feature
+/// `fmu`): a library that links this crate for the model only (gearbox/) must be built
+/// without them.
 pub const FMU_EXPORTS: bool = cfg!(feature = "fmu");
 
 #[cfg(feature = "fmu")]
 fmi2_shell::export_co_simulation!(crate::instance::Instance);
 #[cfg(feature = "fmu")]
 fmi2_shell::export_model_exchange!(crate::instance::Instance);
+#[cfg(feature = "fmu")]
+fmi3_shell::export_fmi3!(crate::instance::Instance, crate::contract);

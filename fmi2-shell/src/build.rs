@@ -5,7 +5,7 @@
 //!     categories and GUID the model uses (included by its `contract` module after
 //!     `use fmi2_shell::contract::*`);
 //!
-//! and restricts the cdylib's exports to the `fmi2*` functions ([`restrict_exports`]).
+//! and restricts the cdylib's exports to the `fmi2*` and `fmi3*` functions ([`restrict_exports`]).
 //!
 //! The GUID is a hash of the contract file, so the XML and the binary always carry the same
 //! one and any change of the contract changes it.
@@ -18,6 +18,8 @@
 //! array's variable named bare means the same element's, and `NAME[*].VAR` every element's.
 //! Consecutive declarations of one array expand element by element. The Rust constants give
 //! each array a module, `vr::NAME`, with the value references as arrays (`vr::gear::I_L[i - 1]`).
+
+mod fmi3;
 
 use crate::contract::{Bound, Range};
 use serde::Deserialize;
@@ -125,6 +127,9 @@ struct Variable {
     /// Model Exchange: this variable is the time derivative of the continuous state named
     /// here; the order of these variables is the order of the state vector.
     derivative_of: Option<String>,
+    /// An Integer's values 0, 1, ... by name and description: an Enumeration in FMI 3.0
+    /// (FMI 2.0's description states them).
+    items: Option<Vec<(String, String)>>,
 }
 
 /// A TOML number as f64 (integers are exact up to 2^53).
@@ -191,6 +196,15 @@ pub fn outputs(text: &str) -> Result<(String, String), toml::de::Error> {
     check(&contract);
     let guid = guid_of(text);
     Ok((xml(&contract, &guid), rust(&contract, &guid)))
+}
+
+/// The FMI 3.0 model description of a contract's text, with the same GUID as its
+/// instantiationToken.
+pub fn fmi3_description(text: &str) -> Result<String, toml::de::Error> {
+    let mut contract: Contract = toml::from_str(text)?;
+    expand(&mut contract);
+    check(&contract);
+    Ok(fmi3::xml(&contract, &guid_of(text)))
 }
 
 /// Replaces each array's declarations by its elements' variables, and `NAME[*].VAR` in every
@@ -435,6 +449,114 @@ fn xml_bound(inclusive: &Option<toml::Value>, inside: Option<f64>) -> Option<Str
         .or(inside.map(|x| format!("{x:?}")))
 }
 
+/// A variable's opening tag `element` up to its causality's attributes, with the value
+/// reference `vr`.
+fn variable_head(x: &mut String, element: &str, v: &Variable, vr: u32) {
+    write!(
+        x,
+        "    <{element} name=\"{}\" valueReference=\"{vr}\" description=\"{}\" causality=\"{}\" variability=\"{}\"",
+        esc(&v.name),
+        esc(&v.full_description()),
+        v.causality,
+        v.variability()
+    )
+    .unwrap();
+    if v.causality == "parameter" {
+        *x += " initial=\"exact\"";
+    }
+}
+
+/// A variable's start, unit, display unit, bounds (if `bounded`) and `derivative` (the
+/// state's index or reference) as XML attributes, each where it has one.
+fn attributes(x: &mut String, v: &Variable, bounded: bool, derivative: Option<String>) {
+    let bound = |b: Option<String>| b.filter(|_| bounded);
+    let attributes = [
+        ("start", v.start.as_ref().map(value)),
+        ("unit", v.unit.as_deref().map(esc)),
+        ("displayUnit", v.display_unit.as_deref().map(esc)),
+        (
+            "min",
+            bound(xml_bound(&v.min, v.min_exclusive.map(f64::next_up))),
+        ),
+        (
+            "max",
+            bound(xml_bound(&v.max, v.max_exclusive.map(f64::next_down))),
+        ),
+        ("derivative", derivative),
+    ];
+    for (name, a) in &attributes {
+        if let Some(a) = a {
+            write!(x, " {name}=\"{a}\"").unwrap();
+        }
+    }
+}
+
+/// The initial unknowns by `key` (of a variable's name), sorted, each once: the outputs, and
+/// the states and their derivatives (all calculated: none has a start).
+fn initial_unknowns<T: Ord>(c: &Contract, key: impl Fn(&str) -> T) -> Vec<T> {
+    let mut initial: Vec<T> = c
+        .variable
+        .iter()
+        .filter(|v| v.causality == "output" || v.derivative_of.is_some())
+        .map(|v| key(&v.name))
+        .chain(
+            c.variable
+                .iter()
+                .filter_map(|v| v.derivative_of.as_deref())
+                .map(&key),
+        )
+        .collect();
+    initial.sort();
+    initial.dedup();
+    initial
+}
+
+/// UnitDefinitions, as both editions write them.
+fn units(x: &mut String, c: &Contract) {
+    *x += "  <UnitDefinitions>\n";
+    for u in &c.unit {
+        write!(x, "    <Unit name=\"{}\"><BaseUnit", esc(&u.name)).unwrap();
+        for (k, e) in &u.base {
+            write!(x, " {k}=\"{e}\"").unwrap();
+        }
+        for (k, a) in [("factor", u.factor), ("offset", u.offset)] {
+            if let Some(a) = a {
+                write!(x, " {k}=\"{a:?}\"").unwrap();
+            }
+        }
+        *x += "/>";
+        for d in &u.display {
+            write!(
+                x,
+                "<DisplayUnit name=\"{}\" factor=\"{:?}\"/>",
+                esc(&d.name),
+                d.factor
+            )
+            .unwrap();
+        }
+        *x += "</Unit>\n";
+    }
+    *x += "  </UnitDefinitions>\n";
+}
+
+/// LogCategories and DefaultExperiment, as both editions write them.
+fn log_categories_and_experiment(x: &mut String, c: &Contract) {
+    *x += "  <LogCategories>\n";
+    for (name, description) in &c.log_categories {
+        writeln!(
+            x,
+            "    <Category name=\"{name}\" description=\"{}\"/>",
+            esc(description)
+        )
+        .unwrap();
+    }
+    *x += "  </LogCategories>\n  <DefaultExperiment";
+    for (k, v) in &c.experiment {
+        write!(x, " {k}=\"{v:?}\"").unwrap();
+    }
+    *x += "/>\n";
+}
+
 fn xml(c: &Contract, guid: &str) -> String {
     let mut x = String::new();
     let m = &c.model;
@@ -462,78 +584,16 @@ fn xml(c: &Contract, guid: &str) -> String {
     for (k, v) in &c.capabilities {
         write!(x, " {k}=\"{}\"", value(v)).unwrap();
     }
-    x += "/>\n  <UnitDefinitions>\n";
-    for u in &c.unit {
-        write!(x, "    <Unit name=\"{}\"><BaseUnit", esc(&u.name)).unwrap();
-        for (k, e) in &u.base {
-            write!(x, " {k}=\"{e}\"").unwrap();
-        }
-        for (k, a) in [("factor", u.factor), ("offset", u.offset)] {
-            if let Some(a) = a {
-                write!(x, " {k}=\"{a:?}\"").unwrap();
-            }
-        }
-        x += "/>";
-        for d in &u.display {
-            write!(
-                x,
-                "<DisplayUnit name=\"{}\" factor=\"{:?}\"/>",
-                esc(&d.name),
-                d.factor
-            )
-            .unwrap();
-        }
-        x += "</Unit>\n";
-    }
-    x += "  </UnitDefinitions>\n  <LogCategories>\n";
-    for (name, description) in &c.log_categories {
-        writeln!(
-            x,
-            "    <Category name=\"{name}\" description=\"{}\"/>",
-            esc(description)
-        )
-        .unwrap();
-    }
-    x += "  </LogCategories>\n  <DefaultExperiment";
-    for (k, v) in &c.experiment {
-        write!(x, " {k}=\"{v:?}\"").unwrap();
-    }
-    x += "/>\n  <ModelVariables>\n";
+    x += "/>\n";
+    units(&mut x, c);
+    log_categories_and_experiment(&mut x, c);
+    x += "  <ModelVariables>\n";
     for (i, v) in c.variable.iter().enumerate() {
         writeln!(x, "    <!-- index {} -->", i + 1).unwrap();
-        write!(
-            x,
-            "    <ScalarVariable name=\"{}\" valueReference=\"{}\" description=\"{}\" causality=\"{}\" variability=\"{}\"",
-            esc(&v.name),
-            v.vr,
-            esc(&v.full_description()),
-            v.causality,
-            v.variability()
-        )
-        .unwrap();
-        if v.causality == "parameter" {
-            x += " initial=\"exact\"";
-        }
+        variable_head(&mut x, "ScalarVariable", v, v.vr);
         write!(x, ">\n      <{}", v.ty).unwrap();
-        let attributes = [
-            ("start", v.start.as_ref().map(value)),
-            ("unit", v.unit.as_deref().map(esc)),
-            ("displayUnit", v.display_unit.as_deref().map(esc)),
-            ("min", xml_bound(&v.min, v.min_exclusive.map(f64::next_up))),
-            (
-                "max",
-                xml_bound(&v.max, v.max_exclusive.map(f64::next_down)),
-            ),
-            (
-                "derivative",
-                v.derivative_of.as_deref().map(|s| index_of(s).to_string()),
-            ),
-        ];
-        for (name, a) in &attributes {
-            if let Some(a) = a {
-                write!(x, " {name}=\"{a}\"").unwrap();
-            }
-        }
+        let derivative = v.derivative_of.as_deref().map(|s| index_of(s).to_string());
+        attributes(&mut x, v, true, derivative);
         x += "/>\n    </ScalarVariable>\n";
     }
     x += "  </ModelVariables>\n  <ModelStructure>\n    <Outputs>\n";
@@ -576,18 +636,7 @@ fn xml(c: &Contract, guid: &str) -> String {
         x += "    </Derivatives>\n";
     }
     x += "    <InitialUnknowns>\n";
-    // Outputs, and the states and their derivatives (all calculated: none has a start).
-    let mut initial: Vec<usize> = outputs.iter().map(|(i, _)| *i).collect();
-    initial.extend(derivatives.iter().map(|(i, _)| *i));
-    initial.extend(
-        c.variable
-            .iter()
-            .filter_map(|v| v.derivative_of.as_deref())
-            .map(index_of),
-    );
-    initial.sort();
-    initial.dedup();
-    for i in initial {
+    for i in initial_unknowns(c, index_of) {
         writeln!(x, "      <Unknown index=\"{i}\"/>").unwrap();
     }
     x += "    </InitialUnknowns>\n  </ModelStructure>\n</fmiModelDescription>\n";
@@ -758,7 +807,7 @@ fn rust(c: &Contract, guid: &str) -> String {
 /// ld's PE back end can only add to such a list (a second .def is merged into it;
 /// --exclude-symbols only affects automatic exports), so nothing here can take a name out.
 /// The linker set in .cargo/config.toml, mk/windows-link.sh, links with a copy of rustc's
-/// list narrowed to fmi2*; tests/windows/run.sh checks the DLL's export table.
+/// list narrowed to fmi2* and fmi3*; tests/windows/run.sh checks the DLL's export table.
 ///
 /// macOS: see `apple_link_args`.
 pub fn restrict_exports() {
@@ -773,7 +822,7 @@ pub fn restrict_exports() {
     let script = out.join("exports.map");
     fs::write(
         &script,
-        "{\n  global: fmi2*;\n  local: callback_log; *;\n};\n",
+        "{\n  global: fmi2*; fmi3*;\n  local: callback_log; *;\n};\n",
     )
     .unwrap();
     println!(
@@ -786,7 +835,7 @@ pub fn restrict_exports() {
 /// libiconv (and cargo-zigbuild adds libcharset with it), which nothing here calls; without
 /// -dead_strip_dylibs both would be load commands, and a dylib that needs libSystem alone
 /// loads on any macOS. Its install name is `@rpath/lib<crate>.dylib`, not the path it was
-/// linked at on the build machine. The exports are kept to fmi2* by mk/darwin-link.py and
+/// linked at on the build machine. The exports are kept to fmi2* and fmi3* by mk/darwin-link.py and
 /// mk/darwin-exports.py: zig's Mach-O linker ignores the exported-symbols list that rustc
 /// passes.
 fn apple_link_args() {
@@ -966,18 +1015,22 @@ mod tests {
 }
 "#;
 
-    /// Both contracts' model descriptions through fmpy's validate_fmu (the schema, variable
-    /// names, ModelStructure, start values, units). The Python with fmpy is $FMPY_PYTHON, or
+    /// Both contracts' model descriptions, FMI 2.0's and FMI 3.0's, through fmpy's
+    /// validate_fmu (the schema, variable names, ModelStructure, start values, units). The Python with fmpy is $FMPY_PYTHON, or
     /// the repository's .venv (`make setup`).
     #[test]
     fn model_descriptions_pass_fmpy_validation() {
         let python = env::var("FMPY_PYTHON")
             .unwrap_or_else(|_| format!("{}/../.venv/bin/python", env!("CARGO_MANIFEST_DIR")));
         for name in ["GearRattle", "GearboxRattle"] {
-            let (xml, _) = outputs(&contract(name)).unwrap();
-            let dir = scratch(name);
-            fs::write(dir.join("modelDescription.xml"), xml).unwrap();
-            let run = Command::new(&python)
+            let text = contract(name);
+            for (edition, xml) in [
+                ("2.0", outputs(&text).unwrap().0),
+                ("3.0", fmi3_description(&text).unwrap()),
+            ] {
+                let dir = scratch(&format!("{name}-{edition}"));
+                fs::write(dir.join("modelDescription.xml"), xml).unwrap();
+                let run = Command::new(&python)
                 .args([
                     "-c",
                     "import sys; from fmpy.validation import validate_fmu; p = validate_fmu(sys.argv[1]); print(*p, sep='\\n'); sys.exit(len(p) > 0)",
@@ -985,8 +1038,9 @@ mod tests {
                 .arg(&dir)
                 .output()
                 .unwrap_or_else(|e| panic!("{python}: {e} (set FMPY_PYTHON or run make setup)"));
-            succeeded(name, &run);
-            fs::remove_dir_all(dir).unwrap();
+                succeeded(&format!("{name} (FMI {edition})"), &run);
+                fs::remove_dir_all(dir).unwrap();
+            }
         }
     }
 }

@@ -200,3 +200,16 @@ pub fn no_variables(kind: &str, vrs: &[u32]) -> FmiResult {
         ))),
     }
 }
+
+/// FMI 3.0's value references: one space for all variables, where FMI 2.0 has one per type.
+/// The FMI 3.0 model description and exports keep a Real's reference, move an Integer's by
+/// [`INTEGER_VR_OFFSET`](fmi3::INTEGER_VR_OFFSET), and give the variables FMI 3.0 declares
+/// beyond the contract's, the independent variable `time` and Model Exchange's event
+/// indicators, references from [`TIME_VR`](fmi3::TIME_VR) on. A contract's references stay
+/// below the offset (the generator checks).
+pub mod fmi3 {
+    pub const INTEGER_VR_OFFSET: u32 = 1_000_000;
+    pub const TIME_VR: u32 = 2_000_000;
+    /// The first event indicator's; the k-th (from 0) is this + k.
+    pub const EVENT_INDICATOR_VR: u32 = TIME_VR + 1;
+}

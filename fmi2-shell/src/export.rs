@@ -14,7 +14,10 @@ use std::ffi::CStr;
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
 /// A C string argument as &str (None for NULL or invalid UTF-8).
-unsafe fn text<'a>(s: fmi2String) -> Option<&'a str> {
+///
+/// # Safety
+/// `s` is NULL or a NUL-terminated string.
+pub unsafe fn text<'a>(s: fmi2String) -> Option<&'a str> {
     if s.is_null() {
         None
     } else {
@@ -41,8 +44,20 @@ unsafe fn check_instantiate<S: Slave>(
         }
     };
     // SAFETY: the importer's string argument.
+    unsafe { check_token::<S>(guid) }?;
+    Ok(interface)
+}
+
+/// Whether the importer's GUID (FMI 3.0: instantiationToken) is the one this binary was
+/// built with.
+///
+/// # Safety
+/// `guid` is NULL or a NUL-terminated string.
+pub unsafe fn check_token<S: Slave>(guid: fmi2String) -> FmiResult {
+    let id = &S::IDENTITY;
+    // SAFETY: the importer's string argument.
     match unsafe { text(guid) } {
-        Some(guid) if guid == id.guid => Ok(interface),
+        Some(guid) if guid == id.guid => Ok(()),
         other => Err(FmiError::error(format!(
             "GUID {other:?} does not match this binary's {}: the model description and the binary are from different builds",
             id.guid
@@ -57,12 +72,36 @@ pub unsafe fn instantiate<S: Slave>(
     functions: *const fmi2CallbackFunctions,
     logging_on: fmi2Boolean,
 ) -> fmi2Component {
+    // SAFETY: NULL is tolerated; otherwise the importer's callback table.
+    let (callback, environment) = match unsafe { functions.as_ref() } {
+        Some(f) => (f.logger, f.componentEnvironment),
+        None => (None, std::ptr::null_mut()),
+    };
+    // SAFETY: the importer's arguments.
+    unsafe {
+        create::<S>(
+            "fmi2Instantiate",
+            instance_name,
+            |name| Logger::new(callback, environment, name),
+            || check_instantiate::<S>(fmu_type, guid),
+            logging_on != 0,
+        )
+    }
+}
+
+/// A new instance behind a component pointer, or NULL (logged) for an empty name or the
+/// error `check` finds in the importer's other arguments (no panic crosses the C boundary).
+///
+/// # Safety
+/// `instance_name` is NULL or a NUL-terminated string; `check` reads only valid arguments.
+pub unsafe fn create<S: Slave>(
+    function: &str,
+    instance_name: fmi2String,
+    logger: impl FnOnce(&CStr) -> Logger,
+    check: impl FnOnce() -> FmiResult<Interface>,
+    logging_on: bool,
+) -> fmi2Component {
     catch_unwind(AssertUnwindSafe(|| {
-        // SAFETY: NULL is tolerated; otherwise the importer's callback table.
-        let (callback, environment) = match unsafe { functions.as_ref() } {
-            Some(f) => (f.logger, f.componentEnvironment),
-            None => (None, std::ptr::null_mut()),
-        };
         // The name is only handed back to the logger: kept as the importer's bytes, UTF-8
         // or not (FMI asks for UTF-8; some importers pass their code page).
         let name = if instance_name.is_null() {
@@ -71,26 +110,25 @@ pub unsafe fn instantiate<S: Slave>(
             // SAFETY: a non-null fmi2String is a NUL-terminated string owned by the importer.
             unsafe { CStr::from_ptr(instance_name) }
         };
-        let logger = Logger::new(callback, environment, name);
+        let logger = logger(name);
         let error = S::IDENTITY.log_categories[0].0;
         if name.is_empty() {
             logger.log(
                 Status::Error,
                 error,
-                "fmi2Instantiate: instanceName is missing or empty",
+                &format!("{function}: instanceName is missing or empty"),
             );
             return std::ptr::null_mut();
         }
-        // SAFETY: the importer's arguments.
-        let interface = match unsafe { check_instantiate::<S>(fmu_type, guid) } {
+        let interface = match check() {
             Ok(interface) => interface,
             Err(e) => {
-                logger.log(e.status, error, &format!("fmi2Instantiate: {}", e.message));
+                logger.log(e.status, error, &format!("{function}: {}", e.message));
                 return std::ptr::null_mut();
             }
         };
         let component = Box::new(Component {
-            fmu: Fmu::<S>::new(logging_on != 0, interface),
+            fmu: Fmu::<S>::new(logging_on, interface),
             logger,
         });
         Box::into_raw(component) as fmi2Component

@@ -3,6 +3,7 @@
 //! serialized form: a header (the model's magic, the format's version, the length), the
 //! postcard bytes of the GUID and the instance ([`Fmu`]), and a CRC-32 of those bytes.
 
+use crate::component::{slice, slice_mut};
 use crate::fmu::Fmu;
 use crate::slave::Slave;
 use crate::status::{FmiError, FmiResult};
@@ -111,6 +112,57 @@ pub fn serialize<S: Slave>(fmu: &Fmu<S>) -> Vec<u8> {
     bytes.extend_from_slice(&payload);
     bytes.extend_from_slice(&crc32fast::hash(&payload).to_le_bytes());
     bytes
+}
+
+/// fmi2SerializedFMUstateSize (fmi3SerializedFMUStateSize): the serialized length of a
+/// state into the importer's `size`.
+///
+/// # Safety
+/// `state` as for [`get`]; `size` NULL or the importer's pointer to one value.
+pub unsafe fn serialized_size<S: Slave>(state: fmi2FMUstate, size: *mut usize) -> FmiResult {
+    // SAFETY: the caller's contract.
+    let saved = unsafe { get::<S>(state) }?;
+    unsafe { slice_mut(size, 1, "size") }?[0] = serialize(&saved.fmu).len();
+    Ok(())
+}
+
+/// fmi2SerializeFMUstate (fmi3SerializeFMUState): the serialized state into the importer's
+/// `size` bytes, which must be its length.
+///
+/// # Safety
+/// `state` as for [`get`]; `bytes` NULL or the importer's `size` writable bytes.
+pub unsafe fn serialize_into<S: Slave>(
+    state: fmi2FMUstate,
+    bytes: *mut u8,
+    size: usize,
+    size_function: &str,
+) -> FmiResult {
+    // SAFETY: the caller's contract.
+    let data = serialize(&unsafe { get::<S>(state) }?.fmu);
+    if data.len() != size {
+        return Err(FmiError::error(format!(
+            "size {size} given, the serialized state has {} bytes ({size_function})",
+            data.len()
+        )));
+    }
+    unsafe { slice_mut(bytes, size, "serializedState") }?.copy_from_slice(&data);
+    Ok(())
+}
+
+/// fmi2DeSerializeFMUstate (fmi3DeserializeFMUState): the state decoded from the importer's
+/// bytes into its slot.
+///
+/// # Safety
+/// `bytes` NULL or the importer's `size` bytes; `state` as for [`store`].
+pub unsafe fn deserialize_from<S: Slave>(
+    bytes: *const u8,
+    size: usize,
+    state: *mut fmi2FMUstate,
+) -> FmiResult {
+    // SAFETY: the caller's contract.
+    let data = unsafe { slice(bytes, size, "serializedState") }?;
+    let fmu = deserialize::<S>(data)?;
+    unsafe { store(state, fmu) }
 }
 
 fn refuse(why: &str) -> FmiError {

@@ -1,10 +1,12 @@
-//! The importer's logger callback, and FMI statuses as C values.
+//! The importer's logger callback (FMI 2.0's printf-like one or FMI 3.0's), and FMI statuses
+//! as C values (FMI 3.0's are FMI 2.0's numbers).
 
 use crate::status::Status;
 use fmi_sys::fmi2::{
     fmi2CallbackLogger, fmi2ComponentEnvironment, fmi2Status, fmi2Status_fmi2Discard,
     fmi2Status_fmi2Error, fmi2Status_fmi2Fatal, fmi2Status_fmi2OK, fmi2Status_fmi2Warning,
 };
+use fmi_sys::fmi3::{fmi3InstanceEnvironment, fmi3LogMessageCallback};
 use std::ffi::{CStr, CString};
 
 pub fn fmi2_status(status: Status) -> fmi2Status {
@@ -22,9 +24,17 @@ pub fn c_string(text: &str) -> CString {
     CString::new(text.replace('\0', " ")).expect("no NUL left")
 }
 
+/// The importer's logger callback of either edition.
+enum Callback {
+    /// FMI 2.0: the instance's name in each call, the message a printf format.
+    Fmi2(fmi2CallbackLogger),
+    /// FMI 3.0: the message as it is.
+    Fmi3(fmi3LogMessageCallback),
+}
+
 /// The importer's logger, its environment and the instance's name.
 pub struct Logger {
-    callback: fmi2CallbackLogger,
+    callback: Callback,
     environment: fmi2ComponentEnvironment,
     instance_name: CString,
 }
@@ -36,31 +46,55 @@ impl Logger {
         instance_name: &CStr,
     ) -> Self {
         Logger {
-            callback,
+            callback: Callback::Fmi2(callback),
             environment,
             instance_name: instance_name.to_owned(),
         }
     }
 
-    /// Calls the logger, if there is one. The message is the format string of FMI's
+    /// FMI 3.0's logger (fmi3Instantiate*'s logMessage and instanceEnvironment).
+    pub fn fmi3(
+        callback: fmi3LogMessageCallback,
+        environment: fmi3InstanceEnvironment,
+        instance_name: &CStr,
+    ) -> Self {
+        Logger {
+            callback: Callback::Fmi3(callback),
+            environment,
+            instance_name: instance_name.to_owned(),
+        }
+    }
+
+    /// Calls the logger, if there is one. FMI 2.0's message is the format string of a
     /// printf-like logger: its '%' are doubled, so an importer that formats it prints the
-    /// text as it is, and one that does not shows '%%'.
+    /// text as it is, and one that does not shows '%%'. FMI 3.0's is the text.
     pub fn log(&self, status: Status, category: &str, text: &str) {
-        let Some(callback) = self.callback else {
-            return;
-        };
-        let message = c_string(&text.replace('%', "%%"));
         let category = c_string(category);
+        let message = match self.callback {
+            Callback::Fmi2(_) => c_string(&text.replace('%', "%%")),
+            Callback::Fmi3(_) => c_string(text),
+        };
         // SAFETY: the importer's callback with its environment and NUL-terminated strings
         // that live through the call.
-        unsafe {
-            callback(
-                self.environment,
-                self.instance_name.as_ptr(),
-                fmi2_status(status),
-                category.as_ptr(),
-                message.as_ptr(),
-            )
+        match self.callback {
+            Callback::Fmi2(Some(callback)) => unsafe {
+                callback(
+                    self.environment,
+                    self.instance_name.as_ptr(),
+                    fmi2_status(status),
+                    category.as_ptr(),
+                    message.as_ptr(),
+                )
+            },
+            Callback::Fmi3(Some(callback)) => unsafe {
+                callback(
+                    self.environment,
+                    fmi2_status(status),
+                    category.as_ptr(),
+                    message.as_ptr(),
+                )
+            },
+            Callback::Fmi2(None) | Callback::Fmi3(None) => {}
         }
     }
 }

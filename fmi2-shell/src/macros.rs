@@ -24,16 +24,18 @@ macro_rules! array {
     };
 }
 
-/// Defines the module `$module` of exports for the slave type `$slave`: the `items` as they
-/// are, then each `fn fmi2Name(args after the component) ALLOWED |fmu| body;` as
-/// `fmi2Name(fmi2Component c, args)`, which runs `body` on the instance (`Fmu<$slave>`)
-/// through the guard under the name "fmi2Name" with the mask `allowed::ALLOWED`. Pointer arguments are the importer's, each
+/// Defines the module `$module` of exports for the slave type `$slave` with the C types of
+/// `$bindings` (fmi-sys's `fmi2` or `fmi3`, whose instance pointers and statuses are the
+/// same C types): the `items` as they are, then each
+/// `fn fmiName(args after the instance) ALLOWED |fmu| body;` as `fmiName(instance, args)`,
+/// which runs `body` on the instance (`Fmu<$slave>`) through the guard under the name
+/// "fmiName" with the mask `$allowed::ALLOWED` (`$allowed` the edition's table). Pointer arguments are the importer's, each
 /// valid for the length the call gives (FMI's contract); the bodies turn them into slices
 /// with [`array!`](crate::array), which refuses a NULL one.
 #[doc(hidden)]
 #[macro_export]
 macro_rules! exports {
-    (mod $module:ident for $slave:ty; { $($items:item)* } $(
+    (mod $module:ident for $slave:ty; use $bindings:path, $table:path; { $($items:item)* } $(
         fn $name:ident($($arg:ident: $ty:ty),* $(,)?) $allowed:ident |$s:pat_param| $body:expr;
     )*) => {
         mod $module {
@@ -42,7 +44,7 @@ macro_rules! exports {
             use $crate::array;
             use $crate::contract::no_variables;
             use $crate::export as e;
-            use $crate::fmi2::*;
+            use $bindings::*;
             use $crate::fmu::Fmu;
             use $crate::slave::Slave as _;
             use $crate::status::FmiError;
@@ -51,8 +53,9 @@ macro_rules! exports {
             $($items)*
             $(
                 #[unsafe(no_mangle)]
-                pub unsafe extern "C" fn $name(c: fmi2Component, $($arg: $ty),*) -> fmi2Status {
-                    $crate::component::guard(c, stringify!($name), $crate::state::allowed::$allowed, |$s: &mut Fmu<S>| $body)
+                pub unsafe extern "C" fn $name(c: *mut ::std::ffi::c_void, $($arg: $ty),*) -> ::std::ffi::c_uint {
+                    use $table as allowed;
+                    $crate::component::guard(c, stringify!($name), allowed::$allowed, |$s: &mut Fmu<S>| $body)
                 }
             )*
         }
@@ -64,9 +67,8 @@ macro_rules! exports {
 #[macro_export]
 macro_rules! export_co_simulation {
     ($slave:ty) => {
-        $crate::exports! { mod fmi2_exports for $slave; {
+        $crate::exports! { mod fmi2_exports for $slave; use $crate::fmi2, $crate::state::allowed; {
             use ::std::ffi::c_char;
-            use $crate::component::{slice, slice_mut};
             use $crate::fmu_state;
 
             #[unsafe(no_mangle)]
@@ -148,28 +150,14 @@ macro_rules! export_co_simulation {
                 FMU_STATE |s| s.restore(&unsafe { fmu_state::get::<S>(state) }?.fmu);
             fn fmi2FreeFMUstate(state: *mut fmi2FMUstate)
                 FMU_STATE |_| unsafe { fmu_state::free::<S>(state) };
-            fn fmi2SerializedFMUstateSize(state: fmi2FMUstate, size: *mut usize) FMU_STATE |_| {
-                let saved = unsafe { fmu_state::get::<S>(state) }?;
-                array!(mut size, 1)[0] = fmu_state::serialize(&saved.fmu).len();
-                Ok(())
-            };
-            fn fmi2SerializeFMUstate(state: fmi2FMUstate, bytes: *mut fmi2Byte, size: usize) FMU_STATE |_| {
-                let data = fmu_state::serialize(&unsafe { fmu_state::get::<S>(state) }?.fmu);
-                if data.len() != size {
-                    return Err(FmiError::error(format!(
-                        "size {size} given, the serialized state has {} bytes (fmi2SerializedFMUstateSize)",
-                        data.len()
-                    )));
-                }
-                unsafe { slice_mut(bytes as *mut u8, size, "serializedState") }?.copy_from_slice(&data);
-                Ok(())
-            };
-            fn fmi2DeSerializeFMUstate(bytes: *const fmi2Byte, size: usize, state: *mut fmi2FMUstate)
-                FMU_STATE |_| {
-                    let data = unsafe { slice(bytes as *const u8, size, "serializedState") }?;
-                    let fmu = fmu_state::deserialize::<S>(data)?;
-                    unsafe { fmu_state::store(state, fmu) }
+            fn fmi2SerializedFMUstateSize(state: fmi2FMUstate, size: *mut usize)
+                FMU_STATE |_| unsafe { fmu_state::serialized_size::<S>(state, size) };
+            fn fmi2SerializeFMUstate(state: fmi2FMUstate, bytes: *mut fmi2Byte, size: usize)
+                FMU_STATE |_| unsafe {
+                    fmu_state::serialize_into::<S>(state, bytes as *mut u8, size, "fmi2SerializedFMUstateSize")
                 };
+            fn fmi2DeSerializeFMUstate(bytes: *const fmi2Byte, size: usize, state: *mut fmi2FMUstate)
+                FMU_STATE |_| unsafe { fmu_state::deserialize_from::<S>(bytes as *const u8, size, state) };
 
             fn fmi2GetDirectionalDerivative(vUnknown_ref: *const fmi2ValueReference, nUnknown: usize,
                 vKnown_ref: *const fmi2ValueReference, nKnown: usize, dvKnown: *const fmi2Real,
@@ -191,7 +179,7 @@ macro_rules! export_co_simulation {
 #[macro_export]
 macro_rules! export_model_exchange {
     ($slave:ty) => {
-        $crate::exports! { mod fmi2_model_exchange_exports for $slave; {}
+        $crate::exports! { mod fmi2_model_exchange_exports for $slave; use $crate::fmi2, $crate::state::allowed; {}
             fn fmi2SetTime(time: fmi2Real) SET_TIME |s| s.set_time(time);
             fn fmi2SetContinuousStates(x: *const fmi2Real, nx: usize)
                 SET_CONTINUOUS_STATES |s| s.slave.set_continuous_states(array!(x, nx));

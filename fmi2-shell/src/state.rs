@@ -21,6 +21,16 @@ pub enum FmiState {
 }
 
 impl FmiState {
+    pub const ALL: [FmiState; 7] = [
+        FmiState::Instantiated,
+        FmiState::InitializationMode,
+        FmiState::StepComplete,
+        FmiState::EventMode,
+        FmiState::ContinuousTimeMode,
+        FmiState::Terminated,
+        FmiState::Error,
+    ];
+
     fn bit(self) -> u8 {
         match self {
             FmiState::Instantiated => INSTANTIATED,
@@ -44,15 +54,16 @@ impl FmiState {
     }
 }
 
-const INSTANTIATED: u8 = 1;
-const INITIALIZATION: u8 = 2;
-const STEP_COMPLETE: u8 = 4;
-const EVENT: u8 = 8;
-const CONTINUOUS: u8 = 16;
-const TERMINATED: u8 = 32;
-const ERROR: u8 = 64;
-const RUNNING: u8 = STEP_COMPLETE | EVENT | CONTINUOUS;
-const ANY: u8 = INSTANTIATED | INITIALIZATION | RUNNING | TERMINATED | ERROR;
+// Each state's bit, for the tables of either edition (fmi3-shell's too).
+pub const INSTANTIATED: u8 = 1;
+pub const INITIALIZATION: u8 = 2;
+pub const STEP_COMPLETE: u8 = 4;
+pub const EVENT: u8 = 8;
+pub const CONTINUOUS: u8 = 16;
+pub const TERMINATED: u8 = 32;
+pub const ERROR: u8 = 64;
+pub const RUNNING: u8 = STEP_COMPLETE | EVENT | CONTINUOUS;
+pub const ANY: u8 = INSTANTIATED | INITIALIZATION | RUNNING | TERMINATED | ERROR;
 
 /// States in which each FMI function may be called.
 pub mod allowed {

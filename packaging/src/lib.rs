@@ -20,6 +20,9 @@ pub struct Model {
     /// The Cargo library target whose shared library is the FMU's binary (`lib<name>.so`).
     pub library: &'static str,
     pub model_description: &'static str,
+    /// The FMI 3.0 model description, for a model that offers FMI 3.0 (its library exports
+    /// the `fmi3*` functions beside the `fmi2*` ones).
+    pub model_description_fmi3: Option<&'static str>,
     /// The files under `documentation/`, by name.
     pub documentation: Vec<(&'static str, Vec<u8>)>,
 }
@@ -33,26 +36,63 @@ pub struct Binary<'a> {
     pub path: &'a Path,
 }
 
-/// Writes the FMU of `model` at `out` with the given binaries.
+/// The edition of FMI an archive is written for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Edition {
+    Fmi2,
+    Fmi3,
+}
+
+/// The folders under `binaries/` of a binary built for FMI 2.0's `platform`: FMI 3.0 names
+/// platforms by architecture and system, and the universal darwin64 binary serves both of
+/// its architectures.
+fn folders(edition: Edition, platform: &'static str) -> Vec<&'static str> {
+    match (edition, platform) {
+        (Edition::Fmi2, _) => vec![platform],
+        (Edition::Fmi3, "linux64") => vec!["x86_64-linux"],
+        (Edition::Fmi3, "win64") => vec!["x86_64-windows"],
+        (Edition::Fmi3, "darwin64") => vec!["x86_64-darwin", "aarch64-darwin"],
+        (Edition::Fmi3, other) => panic!("no FMI 3.0 platform for {other}"),
+    }
+}
+
+/// Writes the FMU of `model` at `out` with the given binaries, for FMI 2.0.
 pub fn write_fmu(out: &Path, model: &Model, binaries: &[Binary]) -> std::io::Result<()> {
+    write_edition(out, model, binaries, Edition::Fmi2)
+}
+
+/// Writes the FMU of `model` at `out` with the given binaries, for `edition` (FMI 3.0: the
+/// same binaries with FMI 3.0's model description and platform folders).
+pub fn write_edition(
+    out: &Path,
+    model: &Model,
+    binaries: &[Binary],
+    edition: Edition,
+) -> std::io::Result<()> {
+    let description = match edition {
+        Edition::Fmi2 => model.model_description,
+        Edition::Fmi3 => model.model_description_fmi3.ok_or_else(|| {
+            std::io::Error::other(format!("{} offers no FMI 3.0", model.identifier))
+        })?,
+    };
     if let Some(dir) = out.parent() {
         std::fs::create_dir_all(dir)?;
     }
     let mut zip = zip::ZipWriter::new(std::fs::File::create(out)?);
     let options = SimpleFileOptions::default().compression_method(zip::CompressionMethod::Deflated);
     zip.start_file("modelDescription.xml", options)?;
-    zip.write_all(model.model_description.as_bytes())?;
+    zip.write_all(description.as_bytes())?;
     for (name, bytes) in &model.documentation {
         zip.start_file(format!("documentation/{name}"), options)?;
         zip.write_all(bytes)?;
     }
     for b in binaries {
-        let name = format!(
-            "binaries/{}/{}.{}",
-            b.platform, model.identifier, b.extension
-        );
-        zip.start_file(name, options.unix_permissions(0o755))?;
-        zip.write_all(&std::fs::read(b.path)?)?;
+        let bytes = std::fs::read(b.path)?;
+        for folder in folders(edition, b.platform) {
+            let name = format!("binaries/{folder}/{}.{}", model.identifier, b.extension);
+            zip.start_file(name, options.unix_permissions(0o755))?;
+            zip.write_all(&bytes)?;
+        }
     }
     zip.finish()?;
     Ok(())

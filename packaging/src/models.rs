@@ -5,11 +5,14 @@ use crate::{Model, contracts, documentation, gearbox_documentation};
 
 /// GearRattle, with its documentation page and the work-precision plot.
 pub fn gear_rattle() -> Model {
-    use contracts::gear_rattle::{MODEL_DESCRIPTION_XML, MODEL_IDENTIFIER};
+    use contracts::gear_rattle::{
+        MODEL_DESCRIPTION_FMI3_XML, MODEL_DESCRIPTION_XML, MODEL_IDENTIFIER,
+    };
     Model {
         identifier: MODEL_IDENTIFIER,
         library: "gear_rattle",
         model_description: MODEL_DESCRIPTION_XML,
+        model_description_fmi3: Some(MODEL_DESCRIPTION_FMI3_XML),
         documentation: vec![
             ("index.html", documentation::index_html().into_bytes()),
             (
@@ -27,6 +30,7 @@ pub fn gearbox_rattle() -> Model {
         identifier: MODEL_IDENTIFIER,
         library: "gearbox_rattle",
         model_description: MODEL_DESCRIPTION_XML,
+        model_description_fmi3: None,
         documentation: vec![(
             "index.html",
             gearbox_documentation::index_html().into_bytes(),
@@ -41,6 +45,7 @@ pub fn flywheel() -> Model {
         identifier: MODEL_IDENTIFIER,
         library: "flywheel",
         model_description: MODEL_DESCRIPTION_XML,
+        model_description_fmi3: None,
         documentation: Vec::new(),
     }
 }

@@ -5,8 +5,8 @@
 #   darwin64  a universal binary of an x86_64 and an arm64 slice, each loading on macOS 11 and later,
 #             linking libSystem alone, its arm64 code signature matching its pages
 #             (macho_signature.py). Built and checked here, never run: there is no macOS here;
-#   all       export exactly the FMI 2.0 functions (Co-Simulation and Model Exchange,
-#             tests/fmi2_functions.txt;
+#   all       export exactly the FMI 2.0 functions (tests/fmi2_functions.txt), and the FMI 3.0
+#             ones (tests/fmi3_functions.txt) for the models tests/exports.sh names;
 #             win64's export table is checked by tests/windows/run.sh), carry no debug
 #             information, and each binary (each darwin slice) is under 1 MB.
 # The pytest suite and tests/windows/run.sh run the linux64 binary of the same FMU.
@@ -43,14 +43,17 @@ DLL=$WORK/fmu/binaries/win64/$MODEL.dll
 for bin in "$SO" "$DYLIB" "$DLL"; do
     [ -f "$bin" ] || { fail "$FMU has no ${bin#"$WORK/fmu/"}"; exit 1; }
 done
-expected=$(grep -v '^#' "$ROOT/tests/fmi2_functions.txt" | sort)
+# shellcheck source=tests/exports.sh
+. "$ROOT/tests/exports.sh"
+expected=$(expected_exports "$MODEL")
+PREFIXES=$(export_prefixes "$MODEL")
 
-# $1: what, $2: the names found; compares them with the FMI 2.0 functions.
+# $1: what, $2: the names found; compares them with the functions expected.
 exports_are_fmi2() {
     if [ "$2" = "$expected" ]; then
-        step "$1 exports exactly the $(wc -l <<<"$expected") fmi2* functions"
+        step "$1 exports exactly the $(wc -l <<<"$expected") $PREFIXES functions"
     else
-        fail "$1 does not export exactly the fmi2* functions (diff expected actual):"
+        fail "$1 does not export exactly the $PREFIXES functions (diff expected actual):"
         diff <(echo "$expected") <(echo "$2") | head -n 20 >&2 || true
     fi
 }
@@ -126,4 +129,4 @@ if [ "$failures" -gt 0 ]; then
     echo "test-portable: $failures check(s) failed" >&2
     exit 1
 fi
-step "OK: $MODEL's linux64, darwin64 and win64 binaries are portable, stripped and export only fmi2*"
+step "OK: $MODEL's linux64, darwin64 and win64 binaries are portable, stripped and export only $PREFIXES"

@@ -35,3 +35,6 @@ def main_shaft_input(scene: str, t_end: float, dt: float = 1e-4, fields=("theta_
     for f in fields:
         sig[f] = values[f]
     return sig
+
+
+FMU3_PATH = ROOT / "target" / "fmu" / "fmi3" / "GearRattle.fmu"

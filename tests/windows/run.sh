@@ -56,21 +56,23 @@ step "FMU carries linux64 and win64 binaries (GUID $GUID)"
 
 # ---- 2. export and import tables of the DLL ----
 x86_64-w64-mingw32-objdump -p "$DLL" >"$WORK/run/objdump.txt" || fail "objdump -p $DLL failed"
-FMI2=$(grep -v "^#" "$ROOT/tests/fmi2_functions.txt")
-expected=$(tr -s ' \n' '\n\n' <<<"$FMI2" | sort)
+# shellcheck source=tests/exports.sh
+. "$ROOT/tests/exports.sh"
+expected=$(expected_exports "$MODEL")
+PREFIXES=$(export_prefixes "$MODEL")
 exported=$(sed -n '/^\[Ordinal\/Name Pointer\] Table/,/^$/p' "$WORK/run/objdump.txt" |
     sed -n 's/^[[:space:]]*\[ *[0-9]*\] //p' | sort)
 entries=$(sed -n '/^Export Address Table -- Ordinal Base/,/^$/p' "$WORK/run/objdump.txt" |
     grep -c 'Export RVA' || true)
 echo "$exported" >"$WORK/run/exports.txt"
 if [ "$exported" != "$expected" ]; then
-    echo "exported by name, versus the FMI 2.0 functions (diff expected actual):" >&2
+    echo "exported by name, versus the $PREFIXES functions (diff expected actual):" >&2
     diff <(echo "$expected") <(echo "$exported") >&2 || true
-    fail "the DLL's export table is not exactly the fmi2* functions (see mk/windows-link.sh)"
+    fail "the DLL's export table is not exactly the $PREFIXES functions (see mk/windows-link.sh)"
 fi
 [ "$entries" -eq "$(wc -l <<<"$expected")" ] ||
     fail "the export address table has $entries entries for $(wc -l <<<"$expected") names (exports by ordinal only?)"
-step "exports: exactly the $entries fmi2* functions of FMI 2.0 (Co-Simulation and Model Exchange)"
+step "exports: exactly the $entries $PREFIXES functions"
 
 # DLLs of every Windows 10 installation that Rust's standard library (windows-gnu, MinGW's
 # msvcrt) may import; anything else (libgcc_s_seh-1.dll, libwinpthread-1.dll, vcruntime140.dll,

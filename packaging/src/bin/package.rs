@@ -1,19 +1,20 @@
 //! Writes the .fmu of one of the workspace's FMUs from its built shared library.
 //!
-//! Usage: `package --model ID [--lib PATH] [--darwin64 PATH] [--win64 PATH] [--out PATH]`,
-//! ID one of the models of `packaging::models` (GearRattle, GearboxRattle, Flywheel); by default the
-//! model's release library of this workspace and `target/fmu/ID.fmu`. Run by `make fmu`
+//! Usage: `package --model ID [--fmi 2|3] [--lib PATH] [--darwin64 PATH] [--win64 PATH]
+//! [--out PATH]`, ID one of the models of `packaging::models` (GearRattle, GearboxRattle,
+//! Flywheel); by default FMI 2.0, the model's release library of this workspace and
+//! `target/fmu/ID.fmu` (FMI 3.0: `target/fmu/fmi3/ID.fmu`, the same binaries). Run by `make fmu`
 //! with the stripped portable binaries (mk/portable.mk, mk/windows.mk) and by
 //! `make flywheel-fmu` (mk/masters.mk).
 
-use packaging::{Binary, Model, models, write_fmu};
+use packaging::{Binary, Edition, Model, models, write_edition};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 fn usage() -> ExitCode {
     let ids: Vec<_> = models::all().iter().map(|m| m.identifier).collect();
     eprintln!(
-        "usage: package --model {} [--lib PATH] [--darwin64 PATH] [--win64 PATH] [--out PATH]",
+        "usage: package --model {} [--fmi 2|3] [--lib PATH] [--darwin64 PATH] [--win64 PATH] [--out PATH]",
         ids.join("|")
     );
     ExitCode::FAILURE
@@ -26,6 +27,7 @@ fn main() -> ExitCode {
     let mut darwin64 = None;
     let mut win64 = None;
     let mut out = None;
+    let mut edition = Edition::Fmi2;
     let mut args = std::env::args().skip(1);
     while let Some(flag) = args.next() {
         let value = args.next();
@@ -34,6 +36,8 @@ fn main() -> ExitCode {
                 Some(m) => model = Some(m),
                 None => return usage(),
             },
+            ("--fmi", Some(v)) if v == "2" => edition = Edition::Fmi2,
+            ("--fmi", Some(v)) if v == "3" => edition = Edition::Fmi3,
             ("--lib", Some(v)) => lib = Some(PathBuf::from(v)),
             ("--darwin64", Some(v)) => darwin64 = Some(PathBuf::from(v)),
             ("--win64", Some(v)) => win64 = Some(PathBuf::from(v)),
@@ -45,7 +49,11 @@ fn main() -> ExitCode {
         return usage();
     };
     let lib = lib.unwrap_or_else(|| root.join(format!("target/release/lib{}.so", model.library)));
-    let out = out.unwrap_or_else(|| root.join(format!("target/fmu/{}.fmu", model.identifier)));
+    let folder = match edition {
+        Edition::Fmi2 => "target/fmu",
+        Edition::Fmi3 => "target/fmu/fmi3",
+    };
+    let out = out.unwrap_or_else(|| root.join(format!("{folder}/{}.fmu", model.identifier)));
     let mut binaries = vec![Binary {
         platform: "linux64",
         extension: "so",
@@ -65,7 +73,7 @@ fn main() -> ExitCode {
             path: dll,
         });
     }
-    match write_fmu(&out, &model, &binaries) {
+    match write_edition(&out, &model, &binaries, edition) {
         Ok(()) => {
             println!("wrote {}", out.display());
             ExitCode::SUCCESS

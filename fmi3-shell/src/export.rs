@@ -1,0 +1,243 @@
+//! What the `fmi3*` exports ([`export_fmi3!`](crate::export_fmi3)) do beyond calling the
+//! instance: instantiation of each interface, FMI 3.0's value references on the slave's
+//! (Real ones as they are, Integer ones moved, the time and the event indicators as
+//! variables), the answers FMI 3.0 asks through pointers, and the adjoint derivatives.
+#![allow(clippy::missing_safety_doc)]
+
+use fmi_sys::fmi3::*;
+use fmi2_shell::component::slice_mut;
+use fmi2_shell::contract::fmi3::{EVENT_INDICATOR_VR, INTEGER_VR_OFFSET, TIME_VR};
+use fmi2_shell::contract::{Kind, unknown};
+use fmi2_shell::export::{check_token, create};
+use fmi2_shell::logger::Logger;
+use fmi2_shell::{EventInfo, FmiError, FmiResult, Fmu, Interface, Slave};
+
+/// fmi3InstantiateModelExchange and fmi3InstantiateCoSimulation: an instance of the
+/// interface `wanted` if the token is this binary's and the model offers the interface, else
+/// NULL and a log line (`wanted` is the reason the caller found in the interface's own
+/// arguments to refuse).
+pub unsafe fn instantiate<S: Slave>(
+    function: &str,
+    wanted: Result<Interface, &str>,
+    instance_name: fmi3String,
+    token: fmi3String,
+    logging_on: bool,
+    environment: fmi3InstanceEnvironment,
+    log_message: fmi3LogMessageCallback,
+) -> fmi3Instance {
+    let check = || {
+        let interface = wanted.map_err(FmiError::error)?;
+        if interface == Interface::ModelExchange && !S::IDENTITY.model_exchange {
+            return Err(FmiError::error(format!(
+                "{} does not offer Model Exchange",
+                S::IDENTITY.model_identifier
+            )));
+        }
+        // SAFETY: the importer's string argument.
+        unsafe { check_token::<S>(token) }?;
+        Ok(interface)
+    };
+    // SAFETY: the importer's arguments.
+    unsafe {
+        create::<S>(
+            function,
+            instance_name,
+            |name| Logger::fmi3(log_message, environment, name),
+            check,
+            logging_on,
+        )
+    }
+}
+
+/// FMI 3.0's nValues for scalar variables: one value per reference.
+pub fn scalars(n_vr: usize, n_values: usize) -> FmiResult {
+    if n_vr == n_values {
+        Ok(())
+    } else {
+        Err(FmiError::error(format!(
+            "nValues = {n_values} for {n_vr} value references: every variable is a scalar"
+        )))
+    }
+}
+
+/// The contract's Integer references of FMI 3.0's ones (Int32 and Enumeration variables).
+fn integer_vrs(vrs: &[u32]) -> FmiResult<Vec<u32>> {
+    vrs.iter()
+        .map(|&vr| {
+            vr.checked_sub(INTEGER_VR_OFFSET)
+                .filter(|v| *v < INTEGER_VR_OFFSET)
+                .ok_or_else(|| unknown(Kind::Integer, vr))
+        })
+        .collect()
+}
+
+/// fmi3GetFloat64: the slave's Real variables, the time and the event indicators (the
+/// slave's whole vector of `indicators` computed once if any is asked).
+pub fn get_float64<S: Slave>(
+    fmu: &mut Fmu<S>,
+    vrs: &[u32],
+    out: &mut [f64],
+    indicators: usize,
+) -> FmiResult {
+    if vrs.iter().all(|&vr| vr < TIME_VR) {
+        return fmu.slave.get_real(vrs, out);
+    }
+    let mut z: Option<Vec<f64>> = None;
+    for (&vr, out) in vrs.iter().zip(out) {
+        let k = vr.wrapping_sub(EVENT_INDICATOR_VR) as usize;
+        *out = match vr {
+            TIME_VR => fmu.time(),
+            _ if vr >= EVENT_INDICATOR_VR && k < indicators => {
+                if z.is_none() {
+                    let mut values = vec![0.0; indicators];
+                    fmu.slave.get_event_indicators(&mut values)?;
+                    z = Some(values);
+                }
+                z.as_ref().expect("computed")[k]
+            }
+            _ => {
+                let mut value = [0.0];
+                fmu.slave.get_real(&[vr], &mut value)?;
+                value[0]
+            }
+        };
+    }
+    Ok(())
+}
+
+/// fmi3GetInt32 (Int32 variables) and fmi3GetInt64 (Enumerations): the slave's Integers.
+pub fn get_integer<S: Slave, T: From<i32>>(
+    fmu: &mut Fmu<S>,
+    vrs: &[u32],
+    out: &mut [T],
+) -> FmiResult {
+    let vrs = integer_vrs(vrs)?;
+    let mut values = vec![0; vrs.len()];
+    fmu.slave.get_integer(&vrs, &mut values)?;
+    for (out, v) in out.iter_mut().zip(values) {
+        *out = v.into();
+    }
+    Ok(())
+}
+
+/// fmi3SetInt32 and fmi3SetInt64: the slave's Integers, a value beyond Int32 refused.
+pub fn set_integer<S: Slave, T: Copy + std::fmt::Display>(
+    fmu: &mut Fmu<S>,
+    vrs: &[u32],
+    values: &[T],
+) -> FmiResult
+where
+    i32: TryFrom<T>,
+{
+    let vrs = integer_vrs(vrs)?;
+    let values = values
+        .iter()
+        .map(|&v| {
+            i32::try_from(v)
+                .map_err(|_| FmiError::error(format!("{v} is beyond the variables' range")))
+        })
+        .collect::<FmiResult<Vec<i32>>>()?;
+    fmu.set_integer(&vrs, &values)
+}
+
+/// fmi3GetAdjointDerivative: sensitivity_j = sum_i seed_i dUnknown_i/dKnown_j, each column
+/// of the Jacobian one directional derivative of the slave along known j.
+pub fn adjoint_derivative<S: Slave>(
+    fmu: &mut Fmu<S>,
+    unknowns: &[u32],
+    knowns: &[u32],
+    seed: &[f64],
+    sensitivity: &mut [f64],
+) -> FmiResult {
+    let mut column = vec![0.0; unknowns.len()];
+    for (known, out) in knowns.iter().zip(sensitivity) {
+        fmu.slave
+            .directional_derivative(unknowns, &[*known], &[1.0], &mut column)?;
+        *out = column.iter().zip(seed).map(|(j, v)| j * v).sum();
+    }
+    Ok(())
+}
+
+/// Writes `value` where the importer's pointer points (a NULL one is not written).
+pub unsafe fn answer<T>(out: *mut T, value: T) {
+    // SAFETY: NULL or the importer's pointer to one value.
+    if let Some(out) = unsafe { out.as_mut() } {
+        *out = value;
+    }
+}
+
+/// fmi3DoStep: the step (never ended early, never asking for event handling or the end)
+/// and its last successful time.
+pub unsafe fn do_step<S: Slave>(
+    fmu: &mut Fmu<S>,
+    current: f64,
+    h: f64,
+    event_handling_needed: *mut bool,
+    terminate_simulation: *mut bool,
+    early_return: *mut bool,
+    last_successful_time: *mut f64,
+) -> FmiResult {
+    let done = fmu.do_step(current, h);
+    // SAFETY: the importer's pointers.
+    unsafe {
+        answer(event_handling_needed, false);
+        answer(terminate_simulation, false);
+        answer(early_return, false);
+        answer(last_successful_time, fmu.last_successful_time());
+    }
+    done
+}
+
+/// fmi3UpdateDiscreteStates's answers.
+pub unsafe fn update_discrete_states(
+    e: EventInfo,
+    needs_update: *mut bool,
+    terminate_simulation: *mut bool,
+    nominals_changed: *mut bool,
+    values_changed: *mut bool,
+    next_event_time_defined: *mut bool,
+    next_event_time: *mut f64,
+) {
+    // SAFETY: the importer's pointers.
+    unsafe {
+        answer(needs_update, e.new_discrete_states_needed);
+        answer(terminate_simulation, e.terminate_simulation);
+        answer(nominals_changed, e.nominals_of_continuous_states_changed);
+        answer(values_changed, e.values_of_continuous_states_changed);
+        answer(next_event_time_defined, e.next_event_time.is_some());
+        answer(next_event_time, e.next_event_time.unwrap_or(0.0));
+    }
+}
+
+/// fmi3GetNumberOf{ContinuousStates,EventIndicators}.
+pub unsafe fn number(out: *mut usize, n: usize) -> FmiResult {
+    // SAFETY: the importer's pointer to one value.
+    unsafe { slice_mut(out, 1, "number") }?[0] = n;
+    Ok(())
+}
+
+/// The error of a function of what this FMU does not offer.
+pub fn not_offered(what: &str) -> FmiResult {
+    Err(FmiError::error(format!(
+        "{what} not offered: the model description declares none"
+    )))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// FMI 3.0's Integer references are the contract's moved by the offset; a Real's, the
+    /// time's or an indicator's is no Integer.
+    #[test]
+    fn integer_references_are_moved_by_the_offset() {
+        assert_eq!(
+            integer_vrs(&[INTEGER_VR_OFFSET + 102, INTEGER_VR_OFFSET]).unwrap(),
+            [102, 0]
+        );
+        for vr in [102, TIME_VR, EVENT_INDICATOR_VR + 1] {
+            assert!(integer_vrs(&[vr]).is_err(), "{vr}");
+        }
+        assert!(scalars(3, 3).is_ok() && scalars(3, 4).is_err());
+    }
+}

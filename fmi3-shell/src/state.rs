@@ -1,0 +1,66 @@
+//! The FMI 3.0 state machine over fmi2-shell's states: for each function, in one table, the
+//! states in which it may be called (as the Reference-FMUs' masks). FMI 3.0's Step Mode is
+//! [`FmiState::StepComplete`](fmi2_shell::FmiState::StepComplete); Co-Simulation never enters
+//! event mode (hasEventMode is false), so Event Mode and Continuous-Time Mode are Model
+//! Exchange's. Configuration, clock activation and intermediate update modes are never
+//! entered: their functions have no state to be called in.
+
+pub mod allowed {
+    /// The functions FMI 3.0 keeps, in the same states as FMI 2.0 (fmi3EnterInitializationMode
+    /// takes fmi2SetupExperiment's arguments in fmi2EnterInitializationMode's state).
+    pub use fmi2_shell::state::allowed::{
+        COMPLETED_INTEGRATOR_STEP, DO_STEP, ENTER_CONTINUOUS_TIME_MODE, ENTER_INITIALIZATION_MODE,
+        EXIT_INITIALIZATION_MODE, FMU_STATE, GET, GET_CONTINUOUS,
+        NEW_DISCRETE_STATES as UPDATE_DISCRETE_STATES, RESET, SET, SET_CONTINUOUS_STATES,
+        SET_DEBUG_LOGGING, SET_TIME, TERMINATE,
+    };
+    use fmi2_shell::state::{ANY, CONTINUOUS, ERROR, STEP_COMPLETE, TERMINATED};
+    /// Model Exchange only: Co-Simulation's event mode is not offered.
+    pub const ENTER_EVENT_MODE: u8 = CONTINUOUS;
+    /// fmi3GetDirectionalDerivative, fmi3GetAdjointDerivative.
+    pub const DERIVATIVES: u8 = GET & !ERROR;
+    /// fmi3EnterStepMode (Co-Simulation's event mode): never in a state to be called.
+    pub const NOT_OFFERED: u8 = 0;
+    /// Without clocks there is nothing to evaluate, wherever the importer asks.
+    pub const EVALUATE_DISCRETE_STATES: u8 = SET_TIME;
+    /// The functions of clocks and configuration mode: admitted in every state, so that their
+    /// body says what is not offered.
+    pub const EXPLAINED_REFUSAL: u8 = ANY;
+    /// fmi3GetNumberOf{ContinuousStates,EventIndicators}: constants of the model.
+    pub const GET_NUMBER_OF: u8 = ANY;
+    pub const GET_OUTPUT_DERIVATIVES: u8 = STEP_COMPLETE | TERMINATED | ERROR;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::allowed::*;
+    use fmi2_shell::FmiState::{self, *};
+
+    /// The table admits each function in FMI 3.0's states and refuses it elsewhere.
+    #[test]
+    fn the_table_follows_fmi3s_state_machine() {
+        let admits = |mask: u8| -> Vec<FmiState> {
+            FmiState::ALL
+                .into_iter()
+                .filter(|s| s.allows(mask))
+                .collect()
+        };
+        assert_eq!(admits(ENTER_INITIALIZATION_MODE), [Instantiated]);
+        assert_eq!(admits(DO_STEP), [StepComplete]);
+        assert_eq!(admits(ENTER_EVENT_MODE), [ContinuousTimeMode]);
+        assert_eq!(admits(UPDATE_DISCRETE_STATES), [EventMode]);
+        assert_eq!(admits(NOT_OFFERED), []);
+        assert_eq!(
+            admits(SET),
+            [
+                Instantiated,
+                InitializationMode,
+                StepComplete,
+                EventMode,
+                ContinuousTimeMode
+            ]
+        );
+        assert!(!admits(TERMINATE).contains(&Instantiated));
+        assert_eq!(admits(RESET).len(), 7);
+    }
+}

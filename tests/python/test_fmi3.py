@@ -1,0 +1,198 @@
+"""The FMI 3.0 FMU (target/fmu/fmi3/GearRattle.fmu, fmi3-shell's exports of the same library)
+against the FMI 2.0 one: the same trajectories to the bit in co-simulation, within the
+tolerance in Model Exchange; FMPy's validation and the FMI 3.0 schema; the low-level API
+(FMU state, serialization, directional and adjoint derivatives, event indicators as
+variables); FMI 3.0's state machine refusing what is not offered, with a log line."""
+
+import ctypes
+import zipfile
+
+import numpy as np
+import pytest
+from fmpy import extract, read_model_description, simulate_fmu
+from fmpy.fmi1 import FMICallException
+from fmpy.fmi3 import FMU3Model, FMU3Slave
+from support.fmu import FMU3_PATH, FMU_PATH, OUTPUTS, main_shaft_input
+
+G = 25e-6
+
+
+@pytest.fixture(scope="module")
+def fmu3_path():
+    if not FMU3_PATH.is_file():
+        pytest.fail(f"{FMU3_PATH} does not exist: build it with `make fmu` (or `cargo run --release "
+                    "-p packaging -- --model GearRattle --fmi 3`)", pytrace=False)
+    return str(FMU3_PATH)
+
+
+@pytest.fixture(scope="module")
+def md3(fmu3_path):
+    # validate=True: the FMI 3.0 XML schema and FMPy's checks of the description.
+    return read_model_description(fmu3_path, validate=True)
+
+
+@pytest.fixture(scope="module")
+def unzipdir3(fmu3_path, tmp_path_factory):
+    return extract(fmu3_path, unzipdir=str(tmp_path_factory.mktemp("GearRattle_fmi3")))
+
+
+def vr_of(md, name):
+    return next(v.valueReference for v in md.modelVariables if v.name == name)
+
+
+def test_validates_and_declares_fmi3s_types(fmu3_path, md3):
+    from fmpy.validation import validate_fmu
+
+    assert validate_fmu(fmu3_path) == []
+    assert md3.fmiVersion == "3.0" and md3.modelExchange and md3.coSimulation
+    types = {v.name: v.type for v in md3.modelVariables}
+    for name in ("excitation", "solver", "contact", "stat_regime"):
+        assert types[name] == "Enumeration", name
+    assert types["impacts_Fplus"] == "Int32" and types["xi"] == "Float64"
+    excitation = next(t for t in md3.typeDefinitions if t.name == "excitation")
+    assert [i.name for i in excitation.items] == ["inputs", "sine", "torque"]
+    xi = next(v for v in md3.modelVariables if v.name == "xi")
+    assert xi.unit == "m" and xi.displayUnit == "um"
+    assert len(md3.eventIndicators) == 5 and len(md3.derivatives) == 10
+    # The FMI 2.0 FMU's GUID is the instantiation token, and the binary is the same file.
+    md2 = read_model_description(str(FMU_PATH))
+    assert md3.instantiationToken == md2.guid
+    with zipfile.ZipFile(fmu3_path) as z3, zipfile.ZipFile(FMU_PATH) as z2:
+        assert z3.read("binaries/x86_64-linux/GearRattle.so") == z2.read("binaries/linux64/GearRattle.so")
+
+
+def run(path, fmi_type, **kw):
+    return simulate_fmu(str(path), fmi_type=fmi_type, output=OUTPUTS, output_interval=1e-4, **kw)
+
+
+def assert_bitwise_equal(a, b):
+    """Every column equal to the bit (fmpy orders the columns by type: Enumerations last)."""
+    assert sorted(a.dtype.names) == sorted(b.dtype.names)
+    for name in a.dtype.names:
+        np.testing.assert_array_equal(a[name], b[name], err_msg=name)
+
+
+@pytest.mark.parametrize("start", [dict(excitation=1, A_rms=500.0), dict(excitation=1, solver=2),
+                                   dict(excitation=2, tau_in=2.0, omega_M=83.0)], ids=["sine", "radau", "torque"])
+def test_co_simulation_equals_fmi2_to_the_bit(fmu3_path, start):
+    kw = dict(start_values=start, stop_time=0.05)
+    fmi2, fmi3 = run(FMU_PATH, "CoSimulation", **kw), run(fmu3_path, "CoSimulation", **kw)
+    assert fmi2["impacts_Fplus"][-1] + fmi2["impacts_Fminus"][-1] > 0
+    assert_bitwise_equal(fmi2, fmi3)
+
+
+def test_co_simulation_with_inputs_equals_fmi2_to_the_bit(fmu3_path):
+    kw = dict(start_values={"excitation": 0}, stop_time=0.03, input=main_shaft_input("S1", 0.03))
+    assert_bitwise_equal(run(FMU_PATH, "CoSimulation", **kw), run(fmu3_path, "CoSimulation", **kw))
+
+
+def test_model_exchange_agrees_with_fmi2_within_the_tolerance(fmu3_path):
+    kw = dict(start_values={"excitation": 1}, stop_time=0.03, solver="CVode", relative_tolerance=1e-9)
+    fmi2, fmi3 = run(FMU_PATH, "ModelExchange", **kw), run(fmu3_path, "ModelExchange", **kw)
+    assert fmi2["impacts_Fplus"][-1] > 0
+    np.testing.assert_array_equal(fmi2["impacts_Fplus"], fmi3["impacts_Fplus"])
+    np.testing.assert_array_equal(fmi2["impacts_Fminus"], fmi3["impacts_Fminus"])
+    assert np.max(np.abs(fmi2["xi"] - fmi3["xi"])) < 1e-4 * G
+
+
+def slave3(md3, unzipdir3, name, messages=None, **kw):
+    fmu = FMU3Slave(guid=md3.instantiationToken, unzipDirectory=unzipdir3,
+                    modelIdentifier=md3.coSimulation.modelIdentifier, instanceName=name)
+    log = None if messages is None else (lambda env, status, category, message: messages.append(message.decode()))
+    fmu.instantiate(logMessage=log, **kw)
+    return fmu
+
+
+def started(md3, unzipdir3, name, messages=None):
+    """A co-simulation instance on the paper's bench sine (the Enumeration set through Int64)."""
+    fmu = slave3(md3, unzipdir3, name, messages)
+    fmu.enterInitializationMode(startTime=0.0)
+    fmu.setInt64([vr_of(md3, "excitation")], [1])
+    fmu.exitInitializationMode()
+    return fmu
+
+
+def test_steps_fmu_state_and_serialization(md3, unzipdir3):
+    fmu = started(md3, unzipdir3, "state")
+    xi, impacts, t_vr = vr_of(md3, "xi"), vr_of(md3, "impacts_Fplus"), vr_of(md3, "time")
+    h = 1e-3
+    for k in range(10):
+        event, terminate, early, last = fmu.doStep(k * h, h)
+        assert (event, terminate, early, last) == (False, False, False, k * h + h)
+    state = fmu.getFMUState()
+    serialized = fmu.serializeFMUState(state)
+    ahead = []
+    for k in range(10, 20):
+        fmu.doStep(k * h, h)
+        ahead.append((fmu.getFloat64([xi, t_vr]), fmu.getInt32([impacts])))
+    for restore in (lambda: fmu.setFMUState(state),
+                    lambda: fmu.setFMUState(fmu.deserializeFMUState(serialized))):
+        restore()
+        assert fmu.getFloat64([t_vr]) == [9 * h + h]
+        again = []
+        for k in range(10, 20):
+            fmu.doStep(k * h, h)
+            again.append((fmu.getFloat64([xi, t_vr]), fmu.getInt32([impacts])))
+        assert again == ahead
+    fmu.freeFMUState(state)
+    fmu.terminate()
+    fmu.freeInstance()
+
+
+def test_directional_and_adjoint_derivatives_in_model_exchange(md3, unzipdir3):
+    fmu = FMU3Model(guid=md3.instantiationToken, unzipDirectory=unzipdir3,
+                    modelIdentifier=md3.modelExchange.modelIdentifier, instanceName="jacobian")
+    fmu.instantiate()
+    fmu.enterInitializationMode(startTime=0.0)
+    fmu.setInt64([vr_of(md3, "excitation")], [1])
+    fmu.setFloat64([vr_of(md3, "B"), vr_of(md3, "xi_dot_start")], [0.3, 0.02])
+    fmu.exitInitializationMode()
+    fmu.updateDiscreteStates()
+    fmu.enterContinuousTimeMode()
+    assert fmu.getNumberOfContinuousStates() == 10 and fmu.getNumberOfEventIndicators() == 5
+    # The event indicators read as variables are fmi3GetEventIndicators's.
+    z = (ctypes.c_double * 5)()
+    fmu.getEventIndicators(z, 5)
+    assert fmu.getFloat64([e.variable.valueReference for e in md3.eventIndicators]) == list(z)
+    states = [d.variable.derivative.valueReference for d in md3.derivatives]
+    derivatives = [d.variable.valueReference for d in md3.derivatives]
+    jacobian = np.array([fmu.getDirectionalDerivative(derivatives, [s], [1.0]) for s in states]).T
+    assert np.any(jacobian != 0)
+    seed = np.linspace(-1.0, 2.0, len(derivatives))
+    adjoint = fmu.getAdjointDerivative(derivatives, states, list(seed))
+    np.testing.assert_allclose(adjoint, jacobian.T @ seed, rtol=1e-14, atol=1e-300)
+    fmu.terminate()
+    fmu.freeInstance()
+
+
+def test_misuse_of_the_state_machine_is_refused_with_a_log_line(md3, unzipdir3):
+    messages = []
+    # Co-Simulation's event mode is not offered.
+    with pytest.raises(Exception, match="Failed to instantiate"):
+        slave3(md3, unzipdir3, "event mode", messages, eventModeUsed=True)
+    assert any("hasEventMode is false" in m for m in messages)
+    # A token from another build.
+    messages.clear()
+    with pytest.raises(Exception, match="Failed to instantiate"):
+        FMU3Slave(guid="{not this one}", unzipDirectory=unzipdir3, modelIdentifier="GearRattle",
+                  instanceName="token").instantiate(logMessage=lambda e, s, c, m: messages.append(m.decode()))
+    assert any("does not match" in m for m in messages)
+    messages.clear()
+    fmu = slave3(md3, unzipdir3, "misuse", messages)
+    with pytest.raises(FMICallException):
+        fmu.doStep(0.0, 1e-3)  # before initialisation
+    assert any("illegal call sequence: fmi3DoStep" in m for m in messages)
+    fmu.enterInitializationMode(startTime=0.0)
+    fmu.exitInitializationMode()
+    for call, text in [(fmu.enterConfigurationMode, "structural parameters are not offered"),
+                       (lambda: fmu.getClock([0]), "clocks are not offered"),
+                       (fmu.enterEventMode, "illegal call sequence: fmi3EnterEventMode"),
+                       (fmu.enterStepMode, "illegal call sequence: fmi3EnterStepMode")]:
+        messages.clear()
+        with pytest.raises(FMICallException):
+            call()
+        assert any(text in m for m in messages), (text, messages)
+    # Still usable.
+    assert fmu.doStep(0.0, 1e-3)[3] == 1e-3
+    fmu.terminate()
+    fmu.freeInstance()
