@@ -31,6 +31,11 @@ contract!(
     "GearRattle (`modelDescription/GearRattle.toml`)."
 );
 contract!(
+    gearbox_rattle,
+    "GearboxRattle",
+    "The gearbox (`modelDescription/GearboxRattle.toml`)."
+);
+contract!(
     flywheel,
     "Flywheel",
     "The drivetrain partner (`partners/flywheel/modelDescription/Flywheel.toml`)."

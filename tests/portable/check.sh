@@ -5,19 +5,21 @@
 #   darwin64  a universal binary of an x86_64 and an arm64 slice, each loading on macOS 11 and later,
 #             linking libSystem alone, its arm64 code signature matching its pages
 #             (macho_signature.py). Built and checked here, never run: there is no macOS here;
-#   all       export exactly the FMI 2.0 and FMI 3.0 functions (tests/fmi2_functions.txt,
-#             tests/fmi3_functions.txt);
+#   all       export exactly the FMI 2.0 functions (tests/fmi2_functions.txt), and the FMI 3.0
+#             ones (tests/fmi3_functions.txt) for the models tests/exports.sh names;
 #             win64's export table is checked by tests/windows/run.sh), carry no debug
 #             information, and each binary (each darwin slice) is under 1 MB.
 # The pytest suite and tests/windows/run.sh run the linux64 binary of the same FMU.
 # Every problem fails the test with a message; nothing is skipped.
 #
-# Usage: tests/portable/check.sh [FMU]   (default target/fmu/GearRattle.fmu)
+# Usage: tests/portable/check.sh [FMU]   (default target/fmu/GearRattle.fmu; the binaries are
+# named after the FMU's file, binaries/linux64/GearboxRattle.so in GearboxRattle.fmu)
 set -euo pipefail
 
 ROOT=$(cd "$(dirname "$0")/../.." && pwd)
 FMU=$(realpath -m "${1:-$ROOT/target/fmu/GearRattle.fmu}")
-WORK=$ROOT/target/portable-test
+MODEL=$(basename "$FMU" .fmu)
+WORK=$ROOT/target/portable-test/$MODEL
 MAX_GLIBC=2.17
 MAX_MACOS=11.0
 MAX_BYTES=$((1024 * 1024))
@@ -35,20 +37,23 @@ done
 [ -f "$FMU" ] || { fail "$FMU does not exist: build it with 'make fmu'"; exit 1; }
 rm -rf "$WORK" && mkdir -p "$WORK"
 python3 -m zipfile -e "$FMU" "$WORK/fmu" || { fail "$FMU is not a readable zip file"; exit 1; }
-SO=$WORK/fmu/binaries/linux64/GearRattle.so
-DYLIB=$WORK/fmu/binaries/darwin64/GearRattle.dylib
-DLL=$WORK/fmu/binaries/win64/GearRattle.dll
+SO=$WORK/fmu/binaries/linux64/$MODEL.so
+DYLIB=$WORK/fmu/binaries/darwin64/$MODEL.dylib
+DLL=$WORK/fmu/binaries/win64/$MODEL.dll
 for bin in "$SO" "$DYLIB" "$DLL"; do
     [ -f "$bin" ] || { fail "$FMU has no ${bin#"$WORK/fmu/"}"; exit 1; }
 done
-expected=$(cat "$ROOT/tests/fmi2_functions.txt" "$ROOT/tests/fmi3_functions.txt" | grep -v '^#' | sort)
+# shellcheck source=tests/exports.sh
+. "$ROOT/tests/exports.sh"
+expected=$(expected_exports "$MODEL")
+PREFIXES=$(export_prefixes "$MODEL")
 
-# $1: what, $2: the names found; compares them with the FMI 2.0 and FMI 3.0 functions.
+# $1: what, $2: the names found; compares them with the functions expected.
 exports_are_fmi2() {
     if [ "$2" = "$expected" ]; then
-        step "$1 exports exactly the $(wc -l <<<"$expected") fmi2* and fmi3* functions"
+        step "$1 exports exactly the $(wc -l <<<"$expected") $PREFIXES functions"
     else
-        fail "$1 does not export exactly the fmi2* and fmi3* functions (diff expected actual):"
+        fail "$1 does not export exactly the $PREFIXES functions (diff expected actual):"
         diff <(echo "$expected") <(echo "$2") | head -n 20 >&2 || true
     fi
 }
@@ -124,4 +129,4 @@ if [ "$failures" -gt 0 ]; then
     echo "test-portable: $failures check(s) failed" >&2
     exit 1
 fi
-step "OK: linux64, darwin64 and win64 binaries are portable, stripped and export only fmi2* and fmi3*"
+step "OK: $MODEL's linux64, darwin64 and win64 binaries are portable, stripped and export only $PREFIXES"

@@ -1,13 +1,15 @@
 #!/usr/bin/env bash
 # The win64 binary of the FMU, checked on Linux (run by `make test-windows`, part of `make test`):
-#   1. the FMU carries binaries/win64/GearRattle.dll beside binaries/linux64/GearRattle.so;
+#   1. the FMU carries binaries/win64/MODEL.dll beside binaries/linux64/MODEL.so, MODEL the
+#      FMU's file name (GearRattle, GearboxRattle);
 #   2. the DLL's export table is exactly the FMI 2.0 Co-Simulation and Model Exchange
 #      functions, and its import
 #      table names only DLLs that a plain Windows 10 has;
 #   3. fmu_run.c, built with MinGW-w64 and run under Wine, steps the DLL through scene S1
-#      (sine mode, the paper's defaults) to 0.2 s in 1 ms communication steps; the same C file
-#      built with gcc steps the linux64 .so the same way; xi must agree within 1e-6 G and the
-#      impact counters exactly.
+#      (GearRattle: sine mode, the paper's defaults; GearboxRattle: its defaults, the engine at
+#      idle, gear 1 read) to 0.2 s in 1 ms communication steps; the same C file built with gcc
+#      steps the linux64 .so the same way; xi must agree within 1e-6 G and the impact counters
+#      exactly.
 # Every problem fails the test with a message; nothing is skipped.
 #
 # Usage: tests/windows/run.sh [FMU]   (default target/fmu/GearRattle.fmu)
@@ -16,6 +18,7 @@ set -euo pipefail
 ROOT=$(cd "$(dirname "$0")/../.." && pwd)
 HERE=$ROOT/tests/windows
 FMU=$(realpath -m "${1:-$ROOT/target/fmu/GearRattle.fmu}")
+MODEL=$(basename "$FMU" .fmu)
 WORK=$ROOT/target/windows-test
 T_END=0.2
 DT=0.001
@@ -40,10 +43,10 @@ done
 rm -rf "$WORK/run"
 mkdir -p "$WORK/run"
 python3 -m zipfile -e "$FMU" "$WORK/run/fmu" || fail "$FMU is not a readable zip file"
-DLL=$WORK/run/fmu/binaries/win64/GearRattle.dll
-SO=$WORK/run/fmu/binaries/linux64/GearRattle.so
-[ -f "$DLL" ] || fail "$FMU has no binaries/win64/GearRattle.dll"
-[ -f "$SO" ] || fail "$FMU has no binaries/linux64/GearRattle.so"
+DLL=$WORK/run/fmu/binaries/win64/$MODEL.dll
+SO=$WORK/run/fmu/binaries/linux64/$MODEL.so
+[ -f "$DLL" ] || fail "$FMU has no binaries/win64/$MODEL.dll"
+[ -f "$SO" ] || fail "$FMU has no binaries/linux64/$MODEL.so"
 if find "$WORK/run/fmu" -iname "bcryptprimitives*" | grep -q .; then
     fail "$FMU carries a bcryptprimitives.dll: the ProcessPrng stand-in is for the Wine test only"
 fi
@@ -53,21 +56,23 @@ step "FMU carries linux64 and win64 binaries (GUID $GUID)"
 
 # ---- 2. export and import tables of the DLL ----
 x86_64-w64-mingw32-objdump -p "$DLL" >"$WORK/run/objdump.txt" || fail "objdump -p $DLL failed"
-FMI2=$(cat "$ROOT/tests/fmi2_functions.txt" "$ROOT/tests/fmi3_functions.txt" | grep -v "^#")
-expected=$(tr -s ' \n' '\n\n' <<<"$FMI2" | sort)
+# shellcheck source=tests/exports.sh
+. "$ROOT/tests/exports.sh"
+expected=$(expected_exports "$MODEL")
+PREFIXES=$(export_prefixes "$MODEL")
 exported=$(sed -n '/^\[Ordinal\/Name Pointer\] Table/,/^$/p' "$WORK/run/objdump.txt" |
     sed -n 's/^[[:space:]]*\[ *[0-9]*\] //p' | sort)
 entries=$(sed -n '/^Export Address Table -- Ordinal Base/,/^$/p' "$WORK/run/objdump.txt" |
     grep -c 'Export RVA' || true)
 echo "$exported" >"$WORK/run/exports.txt"
 if [ "$exported" != "$expected" ]; then
-    echo "exported by name, versus the FMI 2.0 and FMI 3.0 functions (diff expected actual):" >&2
+    echo "exported by name, versus the $PREFIXES functions (diff expected actual):" >&2
     diff <(echo "$expected") <(echo "$exported") >&2 || true
-    fail "the DLL's export table is not exactly the fmi2* and fmi3* functions (see mk/windows-link.sh)"
+    fail "the DLL's export table is not exactly the $PREFIXES functions (see mk/windows-link.sh)"
 fi
 [ "$entries" -eq "$(wc -l <<<"$expected")" ] ||
     fail "the export address table has $entries entries for $(wc -l <<<"$expected") names (exports by ordinal only?)"
-step "exports: exactly the $entries fmi2* and fmi3* functions of FMI 2.0 and FMI 3.0"
+step "exports: exactly the $entries $PREFIXES functions"
 
 # DLLs of every Windows 10 installation that Rust's standard library (windows-gnu, MinGW's
 # msvcrt) may import; anything else (libgcc_s_seh-1.dll, libwinpthread-1.dll, vcruntime140.dll,
@@ -86,10 +91,16 @@ step "imports: $(echo $imports) (all part of Windows 10)"
 CFLAGS="-O2 -std=c11 -Wall -Wextra -Werror"
 gcc $CFLAGS -o "$WORK/run/fmu_run" "$HERE/fmu_run.c" -ldl
 x86_64-w64-mingw32-gcc $CFLAGS -o "$WORK/run/fmu_run.exe" "$HERE/fmu_run.c"
-# For Wine only (see processprng.c): found beside fmu_run.exe when GearRattle.dll is loaded.
+# For Wine only (see processprng.c): found beside fmu_run.exe when the DLL is loaded.
 x86_64-w64-mingw32-gcc $CFLAGS -shared -o "$WORK/run/bcryptprimitives.dll" "$HERE/processprng.c" -ladvapi32
 
-linux=$("$WORK/run/fmu_run" "$SO" "$GUID" $T_END $DT) || fail "the linux64 run failed"
+# The value references fmu_run reads and sets (G, xi, excitation, impacts_Fplus, impacts_Fminus).
+case $MODEL in
+GearRattle) VRS="7 34 100 102 103" ;;
+GearboxRattle) VRS="1105 1120 2 1102 1103" ;; # gear[1]'s
+*) fail "no value references for $MODEL in tests/windows/run.sh" ;;
+esac
+linux=$("$WORK/run/fmu_run" "$SO" "$GUID" $T_END $DT $VRS) || fail "the linux64 run failed"
 echo "  linux64: $linux"
 
 export WINEPREFIX=$WORK/wine-prefix WINEDEBUG=-all,err+module WINEDLLOVERRIDES="mscoree,mshtml,winemenubuilder.exe="
@@ -100,7 +111,7 @@ if [ ! -f "$WINEPREFIX/system.reg" ]; then
         { cat "$WORK/wineboot.log" >&2; fail "wineboot failed or timed out"; }
 fi
 winpath="Z:${DLL//\//\\}"
-windows=$(cd "$WORK/run" && timeout 90 "$WINE" ./fmu_run.exe "$winpath" "$GUID" $T_END $DT | tr -d '\r') ||
+windows=$(cd "$WORK/run" && timeout 90 "$WINE" ./fmu_run.exe "$winpath" "$GUID" $T_END $DT $VRS | tr -d '\r') ||
     fail "the win64 run under Wine failed (messages above)"
 echo "  win64:   $windows"
 
@@ -117,4 +128,4 @@ awk -v a="$(field xi "$linux")" -v b="$(field xi "$windows")" -v g="$(field G "$
     printf "  |xi(linux64) - xi(win64)| = %.3g m (limit 1e-6 G = %.3g m)\n", d, 1e-6 * g
     exit !(g > 0 && d <= 1e-6 * g)
 }' || fail "xi differs by more than 1e-6 G between linux64 and win64"
-step "OK: win64 under Wine agrees with linux64 (S1, $T_END s, dt $DT s)"
+step "OK: $MODEL's win64 under Wine agrees with linux64 ($T_END s, dt $DT s)"

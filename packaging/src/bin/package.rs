@@ -1,9 +1,9 @@
 //! Writes the .fmu of one of the workspace's FMUs from its built shared library.
 //!
 //! Usage: `package --model ID [--fmi 2|3] [--lib PATH] [--darwin64 PATH] [--win64 PATH]
-//! [--out PATH]`, ID one of the models of `packaging::models` (GearRattle, Flywheel); by
-//! default FMI 2.0, the model's release library of this workspace and `target/fmu/ID.fmu`
-//! (FMI 3.0: `target/fmu/fmi3/ID.fmu`, the same binaries). Run by `make fmu`
+//! [--out PATH]`, ID one of the models of `packaging::models` (GearRattle, GearboxRattle,
+//! Flywheel); by default FMI 2.0, the model's release library of this workspace and
+//! `target/fmu/ID.fmu` (FMI 3.0: `target/fmu/fmi3/ID.fmu`, the same binaries). Run by `make fmu`
 //! with the stripped portable binaries (mk/portable.mk, mk/windows.mk) and by
 //! `make flywheel-fmu` (mk/masters.mk).
 
