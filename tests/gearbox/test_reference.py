@@ -10,43 +10,39 @@ from gearrattle import gearbox_fmu as GF
 from gearrattle import gearbox_reference as R
 from support.gearbox import RATE_SPREAD, WINDOW, counts_away_from_impacts, scene_start
 
-T_END = 2.0
-DT = 1e-4
+T_END, DT = 2.0, 1e-4
 # The FMU's tolerance: its error well below 1e-4 G over the windows.
-TOL = {"CoSimulation": 1e-10, "ModelExchange": 1e-10}
-# Rates beyond the window: 0.5 s to the end (the statistics window), from a reference at a
-# looser tolerance (chaotic past the window: only the rates are compared there).
-RATE_T0, RATE_RTOL = 0.5, 1e-9
+TOL = 1e-10
+# Rates beyond the window: 0.5 s to the end (the statistics window). Two runs each within the
+# reference's spread of the mean rate differ by up to twice it.
+RATE_T0 = 0.5
 
 
-def _needs(box_md, fmi_type):
+def _runs(box_run, box_md, scene, fmi_type):
+    """The FMU's run and the reference's (rtol 1e-12), both to T_END with outputs every DT."""
     if fmi_type == "ModelExchange" and box_md.modelExchange is None:
         pytest.fail("the FMU does not offer Model Exchange yet", pytrace=False)
-
-
-def _window_run(box_run, scene, fmi_type):
-    w = WINDOW[scene]
-    return box_run(w, DT, fmi_type, TOL[fmi_type], **scene_start(scene)), R.scene(scene, w, DT)
+    return box_run(T_END, DT, fmi_type, TOL, **scene_start(scene)), R.scene(scene, T_END, DT)
 
 
 @pytest.mark.parametrize("fmi_type", ["CoSimulation", "ModelExchange"])
 @pytest.mark.parametrize("scene", ["B1", "B2", "R1"])
 def test_xi_pointwise_over_window(box_run, box_md, scene, fmi_type):
-    _needs(box_md, fmi_type)
-    fmu, ref = _window_run(box_run, scene, fmi_type)
-    xi = GF.per_gear(fmu, "xi")
+    fmu, ref = _runs(box_run, box_md, scene, fmi_type)
     assert np.allclose(fmu["time"], ref.t, rtol=0, atol=1e-12)
+    w = ref.t <= WINDOW[scene] + 1e-12
+    xi = GF.per_gear(fmu, "xi")[:, w]
     G = np.array([R.gear(ref.params, i + 1)["G"] for i in range(xi.shape[0])])
-    err = np.max(np.abs(xi - ref.xi), axis=1) / G
+    err = np.max(np.abs(xi - ref.xi[:, w]), axis=1) / G
     assert np.all(err < 1e-4), f"{scene} {fmi_type}: max |xi - xi_ref| / G per gear {err}"
 
 
 @pytest.mark.parametrize("fmi_type", ["CoSimulation", "ModelExchange"])
 @pytest.mark.parametrize("scene", ["B1", "B2", "R1"])
 def test_impact_counts_over_window(box_run, box_md, scene, fmi_type):
-    _needs(box_md, fmi_type)
-    fmu, ref = _window_run(box_run, scene, fmi_type)
-    want, got = counts_away_from_impacts(ref, fmu["time"], GF.impact_counts(fmu))
+    fmu, ref = _runs(box_run, box_md, scene, fmi_type)
+    w = ref.t <= WINDOW[scene] + 1e-12
+    want, got = counts_away_from_impacts(ref, ref.t[w], GF.impact_counts(fmu)[:, w])
     assert np.array_equal(got[:, -1], want[:, -1]), f"{scene} {fmi_type}: counts {got[:, -1]} vs {want[:, -1]}"
     assert np.array_equal(got, want), f"{scene} {fmi_type}: the counts differ at some samples"
 
@@ -54,13 +50,11 @@ def test_impact_counts_over_window(box_run, box_md, scene, fmi_type):
 @pytest.mark.parametrize("fmi_type", ["CoSimulation", "ModelExchange"])
 @pytest.mark.parametrize("scene", ["B1", "R1"])
 def test_impact_rates_beyond_window(box_run, box_md, scene, fmi_type):
-    _needs(box_md, fmi_type)
-    fmu = box_run(T_END, DT, fmi_type, None, **scene_start(scene))
-    ref = R.scene(scene, T_END, 1e-2, rtol=RATE_RTOL)
+    fmu, ref = _runs(box_run, box_md, scene, fmi_type)
     t = fmu["time"]
     counts = GF.impact_counts(fmu)
     k0, k1 = np.searchsorted(t, RATE_T0 - 1e-9), t.size - 1
     got = (counts[:, k1] - counts[:, k0]) / (t[k1] - t[k0])
     want = ref.impact_rates(RATE_T0, T_END)
-    spread = RATE_SPREAD[: got.size]
+    spread = 2 * RATE_SPREAD[: got.size]
     assert np.all(np.abs(got - want) <= spread * want + 1.0), f"{scene} {fmi_type}: rates {got} vs {want}"
