@@ -1,6 +1,8 @@
 """libcosim and Ecos run GearboxRattle coupled with the Flywheel partner as its engine
 (excitation 0; gearrattle.gearbox_masters): short runs that must complete, stay near idle,
-rattle, and agree between the two masters (both fixed-step Jacobi on the same steps)."""
+rattle, and agree between the two masters (both fixed-step on the same steps; their first
+steps feed the box's inputs a little differently, which moves phi by some 1e-8 rad, and
+up to 4e-6 rad where the damper changes stage)."""
 
 import numpy as np
 import pytest
@@ -30,5 +32,5 @@ def test_coupled_with_the_flywheel(runs, master):
 def test_masters_agree(runs):
     a, b = runs["libcosim"], runs["ecos"]
     np.testing.assert_allclose(a["omega_F"], b["omega_F"], rtol=1e-9)
-    w = a["time"] <= 0.1  # pointwise while the chaotic box's paths stay together
-    np.testing.assert_allclose(a["phi"][w], b["phi"][w], rtol=0, atol=1e-9)
+    np.testing.assert_allclose(a["phi"], b["phi"], rtol=0, atol=1e-5)  # phi_1 = 0.052 rad
+    assert np.array_equal(a["impacts"][:, -1], b["impacts"][:, -1])
