@@ -7,8 +7,9 @@ use std::fs;
 use std::path::PathBuf;
 
 /// The models' identifiers and contracts, relative to this crate.
-const CONTRACTS: [(&str, &str); 2] = [
+const CONTRACTS: [(&str, &str); 3] = [
     ("GearRattle", "../modelDescription/GearRattle.toml"),
+    ("GearboxRattle", "../modelDescription/GearboxRattle.toml"),
     (
         "Flywheel",
         "../partners/flywheel/modelDescription/Flywheel.toml",

@@ -27,5 +27,7 @@ pub mod math;
 pub mod physics;
 pub mod rattle;
 
+#[cfg(feature = "fmu")]
 fmi2_shell::export_co_simulation!(crate::instance::Instance);
+#[cfg(feature = "fmu")]
 fmi2_shell::export_model_exchange!(crate::instance::Instance);

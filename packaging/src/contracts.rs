@@ -25,6 +25,11 @@ contract!(
     "GearRattle (`modelDescription/GearRattle.toml`)."
 );
 contract!(
+    gearbox_rattle,
+    "GearboxRattle",
+    "The gearbox (`modelDescription/GearboxRattle.toml`)."
+);
+contract!(
     flywheel,
     "Flywheel",
     "The drivetrain partner (`partners/flywheel/modelDescription/Flywheel.toml`)."

@@ -6,6 +6,7 @@
 
 pub mod contracts;
 pub mod documentation;
+pub mod gearbox_documentation;
 pub mod models;
 
 use std::io::Write;

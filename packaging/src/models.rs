@@ -1,7 +1,7 @@
 //! The FMUs of the workspace that the packaging binary knows, by modelIdentifier: each
 //! model's description from its own contract ([`crate::contracts`]), and its documentation.
 
-use crate::{Model, contracts, documentation};
+use crate::{Model, contracts, documentation, gearbox_documentation};
 
 /// GearRattle, with its documentation page and the work-precision plot.
 pub fn gear_rattle() -> Model {
@@ -20,6 +20,20 @@ pub fn gear_rattle() -> Model {
     }
 }
 
+/// GearboxRattle, with its documentation page.
+pub fn gearbox_rattle() -> Model {
+    use contracts::gearbox_rattle::{MODEL_DESCRIPTION_XML, MODEL_IDENTIFIER};
+    Model {
+        identifier: MODEL_IDENTIFIER,
+        library: "gearbox_rattle",
+        model_description: MODEL_DESCRIPTION_XML,
+        documentation: vec![(
+            "index.html",
+            gearbox_documentation::index_html().into_bytes(),
+        )],
+    }
+}
+
 /// The drivetrain partner of the master tests (partners/flywheel), without documentation.
 pub fn flywheel() -> Model {
     use contracts::flywheel::{MODEL_DESCRIPTION_XML, MODEL_IDENTIFIER};
@@ -32,6 +46,6 @@ pub fn flywheel() -> Model {
 }
 
 /// Every model, in the order the usage message lists them.
-pub fn all() -> [Model; 2] {
-    [gear_rattle(), flywheel()]
+pub fn all() -> [Model; 3] {
+    [gear_rattle(), gearbox_rattle(), flywheel()]
 }

@@ -1,7 +1,7 @@
 //! Writes the .fmu of one of the workspace's FMUs from its built shared library.
 //!
 //! Usage: `package --model ID [--lib PATH] [--darwin64 PATH] [--win64 PATH] [--out PATH]`,
-//! ID one of the models of `packaging::models` (GearRattle, Flywheel); by default the
+//! ID one of the models of `packaging::models` (GearRattle, GearboxRattle, Flywheel); by default the
 //! model's release library of this workspace and `target/fmu/ID.fmu`. Run by `make fmu`
 //! with the stripped portable binaries (mk/portable.mk, mk/windows.mk) and by
 //! `make flywheel-fmu` (mk/masters.mk).

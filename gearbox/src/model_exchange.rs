@@ -1,0 +1,198 @@
+//! Model Exchange: the gearbox as continuous states, derivatives and event indicators for
+//! the importer's solver, on the same [`Simulation`] (its gearbox, stage, regions, counters
+//! and statistics windows) as co-simulation, whose own solver then stays idle.
+//!
+//! States (the contract's `STATES`): φ, the input side's speed ω_I (the model integrates
+//! φ' = ω_F − ω_I: ω_I = ω_F(t) − φ'), then each gear slot's ξ and ξ' (a slot beyond n_gears
+//! is unused and constant). Event indicators: per gear slot the contact law's edges ξ + ε,
+//! ξ, ξ − G, ξ − G − ε and ξ' in the gap (its turning points), then the damper's stage edges
+//! φ − φ_1 and φ + φ_1. The derivatives take the formulas of the pieces the states are in;
+//! at an event the gearbox's stage and regions follow them across the edges (an onset counts
+//! an impact and enters the statistics), as the co-simulation's solver does. The energies
+//! and the window's integrals are not states of the contract: in Model Exchange they stay at
+//! their start, and so do the statistics made of them.
+#![allow(non_snake_case)]
+
+use crate::contract::{EVENT_INDICATORS, STATES};
+use crate::simulation::{Run, Simulation};
+use crate::windowed;
+use gear_rattle::gearbox::{Drive, Gearbox, MAX_GEARS, PHI, PHI_DOT, State, xi, xi_dot};
+use gear_rattle::integrator::{Piecewise, System};
+use gear_rattle::physics::{Polynomial, Region, Shaft};
+
+/// Number of continuous states.
+pub const NX: usize = 2 + 2 * MAX_GEARS;
+const _: () = assert!(STATES.len() == NX);
+/// Number of event indicators.
+pub const NZ: usize = EVENT_INDICATORS;
+const _: () = assert!(NZ == 5 * MAX_GEARS + 2);
+
+/// State x's components.
+const X_PHI: usize = 0;
+const X_OMEGA_I: usize = 1;
+const fn x_xi(i: usize) -> usize {
+    2 + 2 * i
+}
+
+impl Simulation {
+    /// The continuous states x.
+    pub fn continuous_states(&self) -> [f64; NX] {
+        let (g, y) = self.gearbox();
+        let mut x = [0.0; NX];
+        if !matches!(g.drive, Drive::InputSide(_)) {
+            x[X_PHI] = y[PHI];
+            x[X_OMEGA_I] = g.flywheel_at(self.t, &y).omega - y[PHI_DOT];
+        }
+        for i in 0..MAX_GEARS {
+            (x[x_xi(i)], x[x_xi(i) + 1]) = (y[xi(i)], y[xi_dot(i)]);
+        }
+        x
+    }
+
+    /// Takes the importer's states x: φ' follows from ω_I and the flywheel's speed now.
+    pub fn set_continuous_states(&mut self, x: &[f64; NX]) {
+        self.change_state(|g, t, y| {
+            if !matches!(g.drive, Drive::InputSide(_)) {
+                y[PHI] = x[X_PHI];
+                y[PHI_DOT] = g.flywheel_at(t, y).omega - x[X_OMEGA_I];
+            }
+            for i in 0..MAX_GEARS {
+                (y[xi(i)], y[xi_dot(i)]) = (x[x_xi(i)], x[x_xi(i) + 1]);
+            }
+        });
+    }
+
+    /// The gearbox at the current states, with the stage and regions they are in (a copy:
+    /// the kept ones change at events only).
+    pub(crate) fn settled(&self) -> (Gearbox, State) {
+        let (g, y) = self.gearbox();
+        let mut g = *g;
+        g.settle(self.t, &y);
+        (g, y)
+    }
+
+    /// dx/dt at the current time and states, with the formulas of the pieces they are in.
+    pub fn derivatives(&self) -> [f64; NX] {
+        let (g, y) = self.settled();
+        let f = g.rhs(self.t, &y);
+        let mut dx = [0.0; NX];
+        if !matches!(g.drive, Drive::InputSide(_)) {
+            dx[X_PHI] = f[PHI];
+            dx[X_OMEGA_I] = g.readout(self.t, &y).input.alpha_I;
+        }
+        for i in 0..g.n_gears() {
+            (dx[x_xi(i)], dx[x_xi(i) + 1]) = (f[xi(i)], f[xi_dot(i)]);
+        }
+        dx
+    }
+
+    /// Nominal magnitudes: φ on the scale of φ_1, ω_I of 100 rad/s, each ξ of its backlash
+    /// and ξ' of a backlash per millisecond.
+    pub fn nominals(&self) -> [f64; NX] {
+        let (g, _) = self.gearbox();
+        let mut x = [1.0; NX];
+        (x[X_PHI], x[X_OMEGA_I]) = (g.damper.params.phi_1, 100.0);
+        for (i, gear) in g.gears.iter().enumerate() {
+            let G = gear.dynamics.params.G;
+            (x[x_xi(i)], x[x_xi(i) + 1]) = (G, G * 1e3);
+        }
+        x
+    }
+
+    /// The event indicators (see the module's documentation); constant 1 for the slots of
+    /// gears the box does not have, and for the damper when the input side is driven.
+    pub fn event_indicators(&self) -> [f64; NZ] {
+        let (g, y) = self.gearbox();
+        let mut z = [1.0; NZ];
+        for (i, gear) in g.gears[..g.n_gears()].iter().enumerate() {
+            let (p, xi) = (&gear.dynamics.params, y[xi(i)]);
+            let turning = if gear.region == Region::Gap {
+                y[xi_dot(i)]
+            } else {
+                1.0
+            };
+            z[5 * i..5 * i + 5].copy_from_slice(&[
+                xi + p.epsilon,
+                xi,
+                xi - p.G,
+                xi - p.G - p.epsilon,
+                turning,
+            ]);
+        }
+        if !matches!(g.drive, Drive::InputSide(_)) {
+            let phi_1 = g.damper.params.phi_1;
+            z[NZ - 2..].copy_from_slice(&[y[PHI] - phi_1, y[PHI] + phi_1]);
+        }
+        z
+    }
+
+    /// The importer's time: the states x stay as set (φ' follows the flywheel's speed).
+    pub fn set_time(&mut self, t: f64) {
+        let x = self.continuous_states();
+        self.t = t;
+        self.set_continuous_states(&x);
+    }
+
+    /// The drive's inputs as the importer sets them (excitation 0 or 2): unlike
+    /// co-simulation's, the states x do not move.
+    pub fn set_drive_inputs(&mut self, flywheel: Shaft, input_side: Shaft) {
+        let x = self.continuous_states();
+        self.change_state(|g, t, _| {
+            g.drive = match g.drive {
+                Drive::Flywheel(_) => Drive::Flywheel(Polynomial {
+                    t0: t,
+                    at_t0: flywheel,
+                }),
+                Drive::InputSide(_) => Drive::InputSide(Polynomial {
+                    t0: t,
+                    at_t0: input_side,
+                }),
+                engine => engine,
+            };
+        });
+        self.set_continuous_states(&x);
+    }
+
+    /// Event mode: the stage and each gear's region follow the states across the edges they
+    /// passed (an onset counts an impact, in the window too), and the statistics window
+    /// opens when its time has come. Returns the next time event: the window's opening, if
+    /// still ahead.
+    pub fn update_discrete_states(&mut self) -> Option<f64> {
+        let t = self.t;
+        match &mut self.run {
+            Run::Lean(k) => settle_past(&mut k.system, t, &k.y),
+            Run::Windowed(k) => settle_past(&mut k.system, t, &k.y),
+        }
+        if self.window_from <= self.t {
+            self.open_window();
+        }
+        matches!(self.run, Run::Lean(_)).then_some(self.window_from)
+    }
+
+    /// After an accepted step of the importer: each gear's |a| there for the window's peak.
+    pub fn completed_integrator_step(&mut self) {
+        let t = self.t;
+        if let Run::Windowed(k) = &mut self.run {
+            let y = windowed::head(&k.y);
+            k.system.sample_accelerations(t, &y);
+        }
+    }
+}
+
+/// Moves every guard of `system` into the piece that holds it at (t, y). The importer's root
+/// search may stop exactly on an edge: each guard is taken a few rounding errors further
+/// along its rate, so that an edge reached on the way out is crossed now, and one just
+/// crossed is not crossed back.
+fn settle_past<S: Piecewise<N>, const N: usize>(system: &mut S, t: f64, y: &[f64; N]) {
+    let mut probe = *y;
+    for k in 0..system.guards() {
+        let (c, rate) = S::guard(k);
+        let (lo, hi) = system.piece(k);
+        let scale = [probe[c], lo, hi]
+            .iter()
+            .filter(|v| v.is_finite())
+            .fold(0.0f64, |m, v| m.max(v.abs()));
+        probe[c] += probe[rate].signum() * 8.0 * f64::EPSILON * scale;
+    }
+    system.settle(t, &probe);
+}

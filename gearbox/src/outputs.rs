@@ -1,0 +1,263 @@
+//! Every output (and local) of the contract, computed from the running gearbox when it is
+//! read (GEARBOX.md §7): the box's, then gear i's by its offset in the gear's block. The
+//! slots of gears beyond n_gears read 0.
+#![allow(non_snake_case, non_upper_case_globals)]
+
+use crate::contract::vr::{self, gear::offset};
+use crate::simulation::Simulation;
+use crate::windowed;
+use gear_rattle::gearbox::{self, Gearbox, Readout, State};
+use gear_rattle::integrator::System;
+use gear_rattle::rattle::window::Metrics;
+
+/// What the outputs are computed from now.
+struct Now<'a> {
+    sim: &'a Simulation,
+    gearbox: Gearbox,
+    y: State,
+    readout: Readout,
+}
+
+impl<'a> Now<'a> {
+    fn new(sim: &'a Simulation) -> Self {
+        let (gearbox, y) = sim.observed();
+        Now {
+            sim,
+            gearbox,
+            y,
+            readout: gearbox.readout(sim.t, &y),
+        }
+    }
+
+    fn gears(&self) -> std::ops::Range<usize> {
+        0..self.gearbox.n_gears()
+    }
+
+    /// ρ_i r_M,i, the lever of gear i's force on the input shaft.
+    fn lever(&self, i: usize) -> f64 {
+        let g = &self.gearbox.gears[i];
+        g.rho * g.dynamics.params.r_M
+    }
+
+    /// Σ ρ_i r_M,i F_i: the gears' torque on the input side.
+    fn tau_I(&self) -> f64 {
+        self.gears()
+            .map(|i| self.lever(i) * self.readout.gears[i].F)
+            .sum()
+    }
+
+    /// c_I(T) ω_I and each loose gear's drag C_i(T) (ω_L,i − ω_S,i) carried to the input
+    /// shaft by ρ_i r_M,i / r_L,i.
+    fn T_drag(&self) -> f64 {
+        let omega_I = self.readout.input.omega_I;
+        let gears: f64 = self
+            .gears()
+            .map(|i| {
+                let p = &self.gearbox.gears[i].dynamics.params;
+                self.lever(i) / p.r_L * p.C * (self.readout.gears[i].omega_L - p.omega_S)
+            })
+            .sum();
+        self.gearbox.c_I * omega_I + gears
+    }
+
+    /// Gear i's window figures (zero before the window opens).
+    fn metrics(&self, i: usize) -> Option<Metrics> {
+        let (windows, w) = self.sim.windows().filter(|_| i < self.gearbox.n_gears())?;
+        let p = &self.gearbox.gears[i].dynamics.params;
+        let q = windowed::quadratures(w, i);
+        Some(windows[i].metrics(self.sim.t, &q, p.I_L / (p.r_L * p.r_L)))
+    }
+
+    /// Gear i's rattle power over the window: its impact energy per second.
+    fn rattle_power(&self, i: usize) -> f64 {
+        self.metrics(i).map_or(0.0, |m| {
+            per_second(&m, m.impact_energy[0] + m.impact_energy[1])
+        })
+    }
+
+    fn box_rattle_power(&self) -> f64 {
+        self.gears().map(|i| self.rattle_power(i)).sum()
+    }
+
+    /// The gear (from 1) with the largest rattle power, 0 without impacts.
+    fn loudest_gear(&self) -> i64 {
+        self.gears()
+            .map(|i| (i, self.rattle_power(i)))
+            .filter(|&(_, p)| p > 0.0)
+            .max_by(|a, b| a.1.total_cmp(&b.1))
+            .map_or(0, |(i, _)| i as i64 + 1)
+    }
+}
+
+fn per_second(m: &Metrics, x: f64) -> f64 {
+    if m.length > 0.0 { x / m.length } else { 0.0 }
+}
+
+impl Simulation {
+    /// The value of a Real output or local, computed now; None if `vr` is none.
+    pub fn real_output(&self, vr: u32) -> Option<f64> {
+        let now = Now::new(self);
+        let b = &now.readout.input;
+        Some(match vr {
+            vr::tau_F => -b.T_cl,
+            vr::tau_I => now.tau_I(),
+            vr::theta_I_out => b.theta_I,
+            vr::omega_I_out | vr::x_omega_I => b.omega_I,
+            vr::alpha_I_out | vr::der_x_omega_I => b.alpha_I,
+            vr::phi => b.phi,
+            vr::der_phi => b.phi_dot,
+            vr::T_clutch => b.T_cl,
+            vr::T_drag => now.T_drag(),
+            vr::E_damper => b.e_damper,
+            vr::stat_rattle_power => now.box_rattle_power(),
+            _ => {
+                let (i, offset) = vr::gear::locate(vr)?;
+                gear_real(&now, i, offset)?
+            }
+        })
+    }
+
+    /// The value of an Integer output; None if `vr` is none.
+    pub fn integer_output(&self, vr: u32) -> Option<i64> {
+        let now = Now::new(self);
+        Some(match vr {
+            vr::damper_stage => 1 + i64::from(now.readout.input.stage.abs()),
+            vr::stat_loudest_gear => now.loudest_gear(),
+            _ => {
+                let (i, offset) = vr::gear::locate(vr)?;
+                gear_integer(&now, i, offset)?
+            }
+        })
+    }
+}
+
+/// Gear i's Real output of `offset` (0 for a gear the box does not have).
+fn gear_real(now: &Now, i: usize, offset: u32) -> Option<f64> {
+    use offset::*;
+    let g = &now.readout.gears[i];
+    let value = match offset {
+        xi => g.xi,
+        xi_dot => g.xi_dot,
+        omega_L => g.omega_L,
+        F_contact => g.F,
+        impact_speed => g.impacts.last_speed,
+        E_contact => g.e_contact,
+        E_lubricant => g.e_lubricant,
+        der_xi | der_xi_dot => {
+            let f = now.gearbox.rhs(now.sim.t, &now.y);
+            let k = if offset == der_xi {
+                gearbox::xi(i)
+            } else {
+                gearbox::xi_dot(i)
+            };
+            f[k]
+        }
+        stat_rattle_share => {
+            let total = now.box_rattle_power();
+            if total > 0.0 {
+                now.rattle_power(i) / total
+            } else {
+                0.0
+            }
+        }
+        _ => {
+            let m = now.metrics(i);
+            return stat_real(m.as_ref(), offset);
+        }
+    };
+    Some(if i < now.gearbox.n_gears() {
+        value
+    } else {
+        0.0
+    })
+}
+
+/// Gear i's Integer output of `offset`.
+fn gear_integer(now: &Now, i: usize, offset: u32) -> Option<i64> {
+    use offset::*;
+    let g = &now.readout.gears[i];
+    Some(match offset {
+        contact => i64::from(g.flank),
+        impacts_Fplus => g.impacts.count[0] as i64,
+        impacts_Fminus => g.impacts.count[1] as i64,
+        _ => return stat_integer(now.metrics(i).as_ref(), offset),
+    })
+}
+
+/// A Real stat_* output of a gear from its window's figures (0 before the window opens);
+/// None if `offset` is none of them. The formulas are GearRattle's (docs/METRICS.md).
+fn stat_real(m: Option<&Metrics>, offset: u32) -> Option<f64> {
+    use offset::*;
+    let known = matches!(
+        offset,
+        stat_window
+            | stat_impact_rate_Fplus
+            | stat_impact_rate_Fminus
+            | stat_run_mean_Fplus
+            | stat_run_mean_Fminus
+            | stat_v_mean_Fplus
+            | stat_v_mean_Fminus
+            | stat_v_rms_Fplus
+            | stat_v_rms_Fminus
+            | stat_v_max_Fplus
+            | stat_v_max_Fminus
+            | stat_E_impact_Fplus
+            | stat_E_impact_Fminus
+            | stat_rattle_power
+            | stat_a_rms
+            | stat_a_peak
+            | stat_F_std
+            | stat_contact_fraction
+            | stat_P_contact
+            | stat_P_lubricant
+    );
+    if !known {
+        return None;
+    }
+    let Some(m) = m else { return Some(0.0) };
+    let [plus, minus] = &m.flanks;
+    Some(match offset {
+        stat_window => m.length,
+        stat_impact_rate_Fplus => per_second(m, plus.impacts as f64),
+        stat_impact_rate_Fminus => per_second(m, minus.impacts as f64),
+        stat_run_mean_Fplus => plus.run_mean(),
+        stat_run_mean_Fminus => minus.run_mean(),
+        stat_v_mean_Fplus => plus.v_mean(),
+        stat_v_mean_Fminus => minus.v_mean(),
+        stat_v_rms_Fplus => plus.v_rms(),
+        stat_v_rms_Fminus => minus.v_rms(),
+        stat_v_max_Fplus => plus.v_max,
+        stat_v_max_Fminus => minus.v_max,
+        stat_E_impact_Fplus => m.impact_energy[0],
+        stat_E_impact_Fminus => m.impact_energy[1],
+        stat_rattle_power => per_second(m, m.impact_energy[0] + m.impact_energy[1]),
+        stat_a_rms => m.a_rms,
+        stat_a_peak => m.a_peak,
+        stat_F_std => m.F_std,
+        stat_contact_fraction => m.contact_fraction,
+        stat_P_contact => m.P_contact,
+        _ => m.P_lubricant,
+    })
+}
+
+/// An Integer stat_* output of a gear; None if `offset` is none of them.
+fn stat_integer(m: Option<&Metrics>, offset: u32) -> Option<i64> {
+    use offset::*;
+    let known = (stat_impacts_Fplus..=stat_side).contains(&offset);
+    if !known {
+        return None;
+    }
+    let Some(m) = m else { return Some(0) };
+    let [plus, minus] = &m.flanks;
+    let (regime, side) = m.regime();
+    Some(match offset {
+        stat_impacts_Fplus => plus.impacts as i64,
+        stat_impacts_Fminus => minus.impacts as i64,
+        stat_runs_Fplus => plus.runs as i64,
+        stat_runs_Fminus => minus.runs as i64,
+        stat_run_max_Fplus => plus.run_max as i64,
+        stat_run_max_Fminus => minus.run_max as i64,
+        stat_regime => regime,
+        _ => side,
+    })
+}

@@ -1,0 +1,354 @@
+//! The running gearbox of an initialised instance: its parameters from the contract's
+//! values, what drives it (GEARBOX.md §4 or the drivetrain's inputs), the solver and the
+//! state, the clock, and the statistics window that opens on the way ([`crate::windowed`]).
+#![allow(non_snake_case)]
+
+use serde::{Deserialize, Serialize};
+
+use crate::contract::{self, vr};
+use crate::windowed::{self, Windowed};
+use fmi2_shell::values::Values;
+use fmi2_shell::{FmiError, FmiResult};
+use gear_rattle::gearbox::{self, Drive, Gearbox, GearboxParams, LooseGear, PHI, State, xi};
+use gear_rattle::integrator::{Jacobian, Method, Piecewise, Solver, SolverError, Stats};
+use gear_rattle::physics::{
+    DamperParams, Engine, EngineOrder, EngineParams, GearParams, Oil, Polynomial, Shaft,
+};
+use gear_rattle::rattle::window::Window;
+
+/// Values of the `excitation` parameter.
+pub const EXCITATION_FLYWHEEL: i64 = 0;
+pub const EXCITATION_ENGINE: i64 = 1;
+pub const EXCITATION_INPUT_SIDE: i64 = 2;
+
+/// A piecewise system with its solver and its state.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Stepped<S, const N: usize> {
+    pub system: S,
+    pub solver: Solver<N>,
+    #[serde(with = "gear_rattle::integrator::serde_array")]
+    pub y: [f64; N],
+}
+
+impl<S: Piecewise<N> + Jacobian<N> + Copy, const N: usize> Stepped<S, N> {
+    /// Advances to t_end; on failure the system, its solver and t are left as they were. A
+    /// call served from the solver's kept step cannot fail and needs no copy to roll back
+    /// to (the solver of the windowed gearbox is some 150 KB).
+    fn advance_to(&mut self, t: &mut f64, t_end: f64) -> Result<(), SolverError> {
+        if self.solver.serve(&mut self.system, t, &mut self.y, t_end) {
+            return Ok(());
+        }
+        let (before, t_before) = (Box::new(*self), *t);
+        let advanced = self.solver.advance(&mut self.system, t, &mut self.y, t_end);
+        if advanced.is_err() {
+            (*self, *t) = (*before, t_before);
+        }
+        advanced
+    }
+}
+
+/// The gearbox before its statistics window opens, and with it.
+#[allow(clippy::large_enum_variant)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub enum Run {
+    Lean(Stepped<Gearbox, { gearbox::N }>),
+    Windowed(Stepped<Windowed, { windowed::N }>),
+}
+
+/// An initialised gearbox being stepped.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Simulation {
+    pub run: Run,
+    pub t: f64,
+    /// Where the statistics window opens: max(stats_from, start time).
+    pub window_from: f64,
+    rtol: f64,
+    method: Method,
+    /// Communication points served from the dense output of natural steps (the built-in
+    /// engine's drive does not change between steps; inputs do).
+    interpolate_ends: bool,
+    /// Model Exchange: the importer integrates, the outputs take the pieces the states are
+    /// in.
+    pub model_exchange: bool,
+}
+
+/// The gearbox's parameters as set: gears 1..n_gears from the per-gear arrays (C and c_I at
+/// 40 °C; the model scales them with the oil), the damper, the engine, the oil.
+pub fn params(values: &Values) -> GearboxParams {
+    let r = |vr: u32| values.real(vr);
+    let n = values
+        .integer(vr::n_gears)
+        .clamp(0, gearbox::MAX_GEARS as i64) as usize;
+    let g = |array: [u32; 8], i: usize| r(array[i]);
+    let gears = (0..n)
+        .map(|i| {
+            use vr::gear;
+            LooseGear {
+                pair: GearParams {
+                    I_L: g(gear::I_L, i),
+                    r_L: g(gear::r_L, i),
+                    r_M: g(gear::r_M, i),
+                    K_star: g(gear::K_star, i),
+                    alpha: g(gear::alpha, i),
+                    epsilon: g(gear::epsilon, i),
+                    G: g(gear::G, i),
+                    C_LM: g(gear::C_LM, i),
+                    C: g(gear::C, i),
+                    B: g(gear::B, i),
+                    omega_S: 0.0,
+                },
+                rho: g(gear::rho, i),
+                sigma: g(gear::sigma, i),
+            }
+        })
+        .collect();
+    let order = |n, a, phase| EngineOrder {
+        n: r(n),
+        a: r(a),
+        phase: r(phase),
+    };
+    GearboxParams {
+        gears,
+        I_I: r(vr::I_I),
+        c_I: r(vr::c_I),
+        damper: DamperParams {
+            k_1: r(vr::k_1),
+            k_2: r(vr::k_2),
+            phi_1: r(vr::phi_1),
+            H_1: r(vr::H_1),
+            H_2: r(vr::H_2),
+            c_cl: r(vr::c_cl),
+            omega_h: r(vr::omega_h),
+        },
+        engine: EngineParams {
+            rpm: r(vr::rpm),
+            rpm_rate: r(vr::rpm_rate),
+            orders: [
+                order(vr::order_1, vr::a_1, vr::phase_1),
+                order(vr::order_2, vr::a_2, vr::phase_2),
+            ],
+        },
+        oil: Oil {
+            nu_40: r(vr::nu_40),
+            nu_100: r(vr::nu_100),
+        },
+        T_oil: r(vr::T_oil),
+    }
+}
+
+/// The flywheel's inputs (excitation 0), or the input side's (excitation 2).
+pub fn flywheel_inputs(values: &Values) -> Shaft {
+    Shaft {
+        theta: values.real(vr::theta_F),
+        omega: values.real(vr::omega_F),
+        alpha: values.real(vr::alpha_F),
+    }
+}
+
+pub fn input_side_inputs(values: &Values) -> Shaft {
+    Shaft {
+        theta: values.real(vr::theta_I),
+        omega: values.real(vr::omega_I),
+        alpha: values.real(vr::alpha_I),
+    }
+}
+
+/// The drive the `excitation` parameter asks for, from t0.
+fn drive(values: &Values, params: &GearboxParams, t0: f64) -> Drive {
+    let from = |at_t0| Polynomial { t0, at_t0 };
+    match values.integer(vr::excitation) {
+        EXCITATION_FLYWHEEL => Drive::Flywheel(from(flywheel_inputs(values))),
+        EXCITATION_ENGINE => Drive::Engine(Engine::new(&params.engine)),
+        EXCITATION_INPUT_SIDE => Drive::InputSide(from(input_side_inputs(values))),
+        other => unreachable!("excitation = {other} is outside the contract's range"),
+    }
+}
+
+/// The integration method the `solver` parameter asks for.
+fn method(values: &Values) -> Method {
+    match values.integer(vr::solver) {
+        0 => Method::Auto,
+        1 => Method::Explicit,
+        2 => Method::Implicit,
+        other => unreachable!("solver = {other} is outside the contract's range"),
+    }
+}
+
+/// `$body` with `$k` the stepped system of `$run`, whichever it is.
+macro_rules! on_run {
+    ($run:expr, $k:ident => $body:expr) => {
+        match $run {
+            Run::Lean($k) => $body,
+            Run::Windowed($k) => $body,
+        }
+    };
+}
+
+impl Simulation {
+    /// Checks the parameters (the contract's ranges, then GEARBOX.md's rules between them)
+    /// and builds GEARBOX.md §6's start at t0 with φ(0) = phi_start and each
+    /// ξ_i(0) = gap_start_i G_i, the output shaft at omega_out.
+    pub fn new(values: &Values, t0: f64, rtol: f64, model_exchange: bool) -> FmiResult<Self> {
+        contract::check_parameters(values)?;
+        let params = params(values);
+        if model_exchange && params.engine.rpm_rate != 0.0 {
+            return Err(FmiError::error(format!(
+                "rpm_rate = {:e} refused in Model Exchange: the ramped engine's angle and speed are states of co-simulation only; set rpm_rate = 0 or use Co-Simulation",
+                params.engine.rpm_rate
+            )));
+        }
+        let drive = drive(values, &params, t0);
+        let (_, mut y) = Gearbox::start(&params, drive)
+            .map_err(|e| FmiError::error(format!("{e}: nothing runs on an invalid gearbox")))?;
+        if !matches!(drive, Drive::InputSide(_)) {
+            y[PHI] = values.real(vr::phi_start);
+        }
+        for (i, gear) in params.gears.iter().enumerate() {
+            y[xi(i)] = values.real(vr::gear::gap_start[i]) * gear.pair.G;
+        }
+        let mut system = Gearbox::new(&params, drive, &y);
+        system.set_output_speed(values.real(vr::omega_out));
+        let method = method(values);
+        let interpolate_ends = matches!(drive, Drive::Engine(_));
+        let mut solver = Solver::with_method(system.tolerance(rtol), method);
+        solver.interpolate_ends = interpolate_ends;
+        let mut sim = Simulation {
+            run: Run::Lean(Stepped { system, solver, y }),
+            t: t0,
+            window_from: values.real(vr::stats_from).max(t0),
+            rtol,
+            method,
+            interpolate_ends,
+            model_exchange,
+        };
+        if sim.window_from <= t0 {
+            sim.open_window();
+        }
+        Ok(sim)
+    }
+
+    /// The statistics window opens now: the windowed gearbox takes over from the lean one
+    /// with a solver of its own size.
+    pub(crate) fn open_window(&mut self) {
+        let Run::Lean(k) = &self.run else {
+            return;
+        };
+        let (system, y) = Windowed::open(k.system, self.t, &k.y);
+        let mut solver = Solver::with_method(system.tolerance(self.rtol), self.method);
+        solver.interpolate_ends = self.interpolate_ends;
+        solver.stats = k.solver.stats;
+        self.run = Run::Windowed(Stepped { system, solver, y });
+    }
+
+    /// Advances to t_end, through the window's opening on the way. On failure the
+    /// simulation is left as it was.
+    pub fn step_to(&mut self, t_end: f64) -> Result<(), SolverError> {
+        if matches!(self.run, Run::Lean(_)) && self.window_from <= t_end {
+            let before = Box::new(*self);
+            let opened = self
+                .advance_to(self.window_from)
+                .map(|()| self.open_window());
+            if let Err(e) = opened.and_then(|()| self.advance_to(t_end)) {
+                *self = *before;
+                return Err(e);
+            }
+        } else {
+            self.advance_to(t_end)?;
+        }
+        self.t = t_end;
+        Ok(())
+    }
+
+    fn advance_to(&mut self, t_end: f64) -> Result<(), SolverError> {
+        on_run!(&mut self.run, k => k.advance_to(&mut self.t, t_end))
+    }
+
+    /// The gearbox and its state now, as the outputs read them: in Model Exchange with the
+    /// stage and regions the states are in.
+    pub fn observed(&self) -> (Gearbox, State) {
+        if self.model_exchange {
+            return self.settled();
+        }
+        let (g, y) = self.gearbox();
+        (*g, y)
+    }
+
+    /// The gearbox and its state now.
+    pub fn gearbox(&self) -> (&Gearbox, State) {
+        match &self.run {
+            Run::Lean(k) => (&k.system, k.y),
+            Run::Windowed(k) => (&k.system.inner, windowed::head(&k.y)),
+        }
+    }
+
+    /// Each gear's statistics window and its quadratures, once it is open.
+    pub fn windows(&self) -> Option<(&[Window; gearbox::MAX_GEARS], &[f64; windowed::N])> {
+        match &self.run {
+            Run::Lean(_) => None,
+            Run::Windowed(k) => Some((&k.system.windows, &k.y)),
+        }
+    }
+
+    /// Changes the gearbox and its state from outside (new inputs): `change` gets the
+    /// gearbox, the time and the gearbox's state; the solver starts afresh.
+    pub(crate) fn change_state(&mut self, change: impl FnOnce(&mut Gearbox, f64, &mut State)) {
+        let t = self.t;
+        match &mut self.run {
+            Run::Lean(k) => {
+                change(&mut k.system, t, &mut k.y);
+                k.solver.invalidate();
+            }
+            Run::Windowed(k) => {
+                let mut y = windowed::head(&k.y);
+                change(&mut k.system.inner, t, &mut y);
+                k.y[..gearbox::N].copy_from_slice(&y);
+                k.solver.invalidate();
+            }
+        }
+    }
+
+    /// New flywheel inputs (excitation 0; ignored otherwise): φ and φ' follow at once.
+    pub fn set_flywheel(&mut self, shaft: Shaft) {
+        if matches!(self.gearbox().0.drive, Drive::Flywheel(_)) {
+            self.change_state(|g, t, y| {
+                g.set_flywheel(t, y, shaft);
+            });
+        }
+    }
+
+    /// New input-side inputs (excitation 2; ignored otherwise): the ξ_i follow at once.
+    pub fn set_input_side(&mut self, shaft: Shaft) {
+        if matches!(self.gearbox().0.drive, Drive::InputSide(_)) {
+            self.change_state(|g, t, y| {
+                g.set_input_side(t, y, shaft);
+            });
+        }
+    }
+
+    /// The output shaft's speed.
+    pub fn set_output_speed(&mut self, omega_out: f64) {
+        self.change_state(|g, _, _| g.set_output_speed(omega_out));
+    }
+
+    /// The imposed motion's extrapolation now (excitation 0: the flywheel's, 2: the input
+    /// side's), which the inputs follow until the master sets them again.
+    pub fn extrapolated_inputs(&self) -> Option<(bool, Shaft)> {
+        match self.gearbox().0.drive {
+            Drive::Flywheel(p) => Some((true, p.at(self.t))),
+            Drive::InputSide(p) => Some((false, p.at(self.t))),
+            Drive::Engine(_) => None,
+        }
+    }
+
+    pub fn stats(&self) -> Stats {
+        on_run!(&self.run, k => k.solver.stats)
+    }
+
+    pub fn is_implicit(&self) -> bool {
+        on_run!(&self.run, k => k.solver.is_implicit())
+    }
+
+    pub fn proposed_step(&self) -> f64 {
+        on_run!(&self.run, k => k.solver.proposed_step())
+    }
+}
