@@ -2,6 +2,7 @@
 oil's temperature (GEARBOX.md §5), the FMU state's replay, eight gears, a stiff gear."""
 
 import math
+import re
 import tomllib
 
 import numpy as np
@@ -127,3 +128,46 @@ def test_eight_gears_against_the_reference(box_run):
     err = np.max(np.abs(xi - ref.xi), axis=1) / G
     assert np.all(err < 1e-4), err
     assert np.array_equal(GF.impact_counts(fmu)[:, -1], ref.impact_counts([t_end])[:, -1])
+
+
+STEP_LOG = re.compile(r"(\d+) accepted \((\d+) by Radau IIA\).* (\d+) rhs evaluations in total; next step \S+ s by (.+)$")
+
+
+def _stepped_with_log(box_unzipdir, box_md, t_end, h, **start):
+    """Steps the box with logStep on: each step's (Radau IIA steps so far, rhs evaluations so
+    far, the method of the next step), and gear 1's xi at each step."""
+    s = Slave(box_unzipdir, box_md, "stiff")
+    try:
+        assert s.set_debug_logging(True, ["logStep"]) == fmi2OK
+        s.init(reals={k: v for k, v in start.items() if not isinstance(v, int)},
+               integers={k: v for k, v in start.items() if isinstance(v, int)})
+        xi = []
+        for _ in range(int(round(t_end / h))):
+            assert s.do_step(h) == fmi2OK
+            xi.append(s.real("gear[1].xi"))
+        steps = [STEP_LOG.search(m) for _, _, m in s.logs]
+        steps = [(int(m[2]), int(m[3]), m[4].strip()) for m in steps if m]
+        assert steps, f"no logStep message with the solver's counts: {s.logs[:3]}"
+        return steps, np.array(xi)
+    finally:
+        s.free()
+
+
+def test_stiff_gear_hands_over_to_radau_and_back(box_unzipdir, box_md):
+    """Gear 1 a thousand times lighter (I_L = 0.75e-6 kg m²: stiff while it is pressed on its
+    flank) with a thirtieth of its drag: the automatic solver hands over to Radau IIA (after
+    some 90 ms) and back to DOPRI5 (after some 220 ms), and gives the explicit method's
+    answer."""
+    light = {"gear[1].I_L": 0.75e-6, "gear[1].C": 2e-3 / 30}
+    t_end, h = 0.3, 1e-4
+    auto, xi_auto = _stepped_with_log(box_unzipdir, box_md, t_end, h, **light)
+    explicit, xi_explicit = _stepped_with_log(box_unzipdir, box_md, t_end, h, solver=1, **light)
+    methods = [m for _, _, m in auto]
+    radau = [k for k, m in enumerate(methods) if m == "Radau IIA"]
+    assert radau, "auto never handed over to Radau IIA"
+    assert "DOPRI5" in methods[radau[0]:], "auto never came back to DOPRI5"
+    assert auto[-1][0] > 0 and explicit[-1][0] == 0
+    G = 80e-6
+    assert np.max(np.abs(xi_auto - xi_explicit)) < 1e-4 * G
+    print(f"stiff gear 1, {t_end:g} s: auto {auto[-1][1]} rhs ({auto[-1][0]} Radau IIA steps), "
+          f"DOPRI5 alone {explicit[-1][1]} rhs")
