@@ -232,7 +232,8 @@ def run_gearbox(box_fmu, out=OUT):
         print(f"demo: no gearbox FMU at {box_fmu}: build it first", file=sys.stderr)
         return 2
     os.makedirs(out, exist_ok=True)
+    figures = gearbox_demo.run(box_fmu, out)
     print("figures:")
-    for f in gearbox_demo.run(box_fmu, out):
+    for f in figures:
         print("  " + f)
     return 0

@@ -93,8 +93,8 @@ def idle_figure(path, res, T, box):
         ax.axhline(s * math.degrees(box["phi_1"]), color="k", ls="--", lw=0.5)
     ax.set_ylabel("twist phi [°]")
     ax.set_xlabel("t [s]")
-    axes[0].set_title(f"Idle 800 rpm, oil {T:g} °C: the gears in their backlash (red: impacts), "
-                      f"the damper's twist against its pre-damper travel (dashed)")
+    axes[0].set_title(f"Idle 800 rpm, oil {T:g} °C: each gear in its backlash (red: impacts),\n"
+                      f"the damper's twist against its pre-damper's travel (dashed)", fontsize=10)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)

@@ -34,11 +34,12 @@ def simulate(fmu, t_end: float, dt: float = 1e-4, fmi_type: str = "CoSimulation"
     """Run the box from 0 to t_end with the start values `start` (contract names, an int sets
     an Integer), outputs every dt; `fmu` a path or an extracted directory. Co-Simulation:
     communication step dt, `tol` to fmi2SetupExperiment; Model Exchange: fmpy's CVode at the
-    relative tolerance `tol`, output every dt. inputs: fmpy's structured input array."""
+    relative tolerance `tol`, output every dt (the rows fmpy adds at events left out).
+    inputs: fmpy's structured input array."""
     from fmpy import simulate_fmu
 
     n = int(start.get("n_gears", 5))
-    return simulate_fmu(
+    res = simulate_fmu(
         str(fmu),
         model_description=model_description,
         fmi_type=fmi_type,
@@ -52,6 +53,16 @@ def simulate(fmu, t_end: float, dt: float = 1e-4, fmi_type: str = "CoSimulation"
         relative_tolerance=tol,
         output=outputs(n, gear_fields),
     )
+    return res if fmi_type == "CoSimulation" else on_grid(res, dt)
+
+
+def on_grid(result, dt: float):
+    """The rows of `result` at the output times k dt, the last one where an event repeats a
+    time."""
+    k = result["time"] / dt
+    on = np.abs(k - np.round(k)) < 1e-6
+    last = np.append(result["time"][1:] != result["time"][:-1], True)
+    return result[on & last]
 
 
 def per_gear(result, field: str) -> np.ndarray:
