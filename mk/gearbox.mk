@@ -13,7 +13,11 @@ gearbox-fmu: $(GEARBOX_FMU)
 
 $(GEARBOX_FMU): FORCE | libclang
 	cargo build --release -p gearbox_rattle
-	cargo run --release --quiet -p packaging -- --model GearboxRattle --lib $(GEARBOX_LIB) --out $@
+	cargo run --release --quiet -p packaging --bin package -- --model GearboxRattle --lib $(GEARBOX_LIB) --out $@
+
+# tests/gearbox is in pytest's testpaths: `make test-python` runs it on this FMU (and on the
+# Flywheel partner's, coupled by libcosim and Ecos).
+test-python: $(GEARBOX_FMU)
 
 ## bench-gearbox: the gearbox's cost against its gears one by one, scipy, a map, n_gears
 bench-gearbox: $(GEARBOX_FMU) fmu $(VENV)/.installed
