@@ -8,13 +8,18 @@ PYTHON ?= python3
 VENV := .venv
 PY := $(VENV)/bin/python
 FMU := target/fmu/GearRattle.fmu
+GEARBOX_FMU := target/fmu/GearboxRattle.fmu
 LIB := target/release/libgear_rattle.so
+# The FMUs `make fmu` builds, by model identifier, and the crate of each one's binary.
+MODELS := GearRattle GearboxRattle
+crate_GearRattle := gear_rattle
+crate_GearboxRattle := gearbox_rattle
 # The FMU's binaries as built (with line tables, for debugging) and as packaged (stripped).
 FMU_DEBUG := target/fmu/debug
 FMU_STRIPPED := target/fmu/stripped
-# Fragments in mk/ (one per capability: windows, benchmarks, rattle map) add to these.
-FMU_DEPS :=
-PACKAGE_FLAGS :=
+# Fragments in mk/ (one per capability: windows, benchmarks, rattle map) add to these;
+# FMU_PLATFORMS: the platforms of the FMUs' binaries as PLATFORM:EXTENSION (linux64:so...).
+FMU_PLATFORMS :=
 TEST_TARGETS := test-rust test-python
 
 .PHONY: all fmu demo test test-rust test-python setup clean
@@ -24,13 +29,21 @@ all: fmu
 # Included before the rules so that the fragments' prerequisites are seen.
 include $(wildcard mk/*.mk)
 
-## fmu: build target/fmu/GearRattle.fmu (linux64, darwin64, win64)
-fmu: $(FMU)
+## fmu: build target/fmu/GearRattle.fmu and GearboxRattle.fmu (linux64, darwin64, win64)
+fmu: $(foreach m,$(MODELS),target/fmu/$(m).fmu)
 
-# The fragments build the binaries and name them in PACKAGE_FLAGS: mk/portable.mk linux64
-# (for glibc 2.17) and darwin64 with zig, mk/windows.mk win64.
-$(FMU): $(FMU_DEPS) $(wildcard packaging/src/*.rs packaging/src/bin/*.rs) | libclang
-	cargo run --release --quiet -p packaging --bin package -- --model GearRattle $(PACKAGE_FLAGS) --out $(FMU)
+# The fragments build the binaries and name their platforms in FMU_PLATFORMS: mk/portable.mk
+# linux64 (for glibc 2.17) and darwin64 with zig, mk/windows.mk win64.
+# $(call binary,MODEL,PLATFORM:EXTENSION): the stripped binary of MODEL for that platform.
+binary = $(FMU_STRIPPED)/$(word 1,$(subst :, ,$(2)))/$(1).$(word 2,$(subst :, ,$(2)))
+# The packaging binary's option for a platform's binary: --lib for linux64, --PLATFORM else.
+package_option = $(if $(filter linux64:%,$(1)),--lib,--$(word 1,$(subst :, ,$(1))))
+
+define fmu_rule
+target/fmu/$(1).fmu: $(foreach p,$(FMU_PLATFORMS),$(call binary,$(1),$(p))) $(wildcard packaging/src/*.rs packaging/src/bin/*.rs) | libclang
+	cargo run --release --quiet -p packaging --bin package -- --model $(1) $(foreach p,$(FMU_PLATFORMS),$(call package_option,$(p)) $(call binary,$(1),$(p))) --out $$@
+endef
+$(foreach m,$(MODELS),$(eval $(call fmu_rule,$(m))))
 
 # The native library, loaded by the C-API tests (the FMU's linux64 binary is built by
 # mk/portable.mk). cargo decides what to rebuild; this rule always asks it.
@@ -47,9 +60,12 @@ demo: fmu $(GEARBOX_FMU) $(VENV)/.installed
 test: $(TEST_TARGETS)
 
 # The C-API tests load the cdylib, which `cargo test` alone does not produce. fmi2-shell's
-# own tests check FMI's rules on a model of their own.
+# own tests check FMI's rules on a model of their own. The gearbox's crate is tested on its
+# own: built with gear_rattle in one cargo call, gear_rattle's `fmu` feature (its fmi2*
+# exports) would be on for the gearbox too, whose own exports would then clash with them.
 test-rust: $(LIB) | libclang
 	cargo test --release -p gear_rattle -p fmi2-shell
+	cargo test --release -p gearbox_rattle
 
 test-python: fmu $(VENV)/.installed
 	$(PY) -m pytest -q

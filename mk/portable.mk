@@ -1,7 +1,7 @@
 # Portable binaries, built with zig through cargo-zigbuild:
-#   linux64   binaries/linux64/GearRattle.so for glibc 2.17 (RHEL 7 and every later Linux),
-#   darwin64  binaries/darwin64/GearRattle.dylib, universal (x86_64 + arm64), macOS 11 or later,
-# and every binary of the FMU stripped when packaged: the unstripped copies, with their line
+#   linux64   binaries/linux64/MODEL.so for glibc 2.17 (RHEL 7 and every later Linux),
+#   darwin64  binaries/darwin64/MODEL.dylib, universal (x86_64 + arm64), macOS 11 or later,
+# for each FMU of MODELS (the Makefile), and every binary of an FMU stripped when packaged: the unstripped copies, with their line
 # tables, stay in target/fmu/debug/<platform>/ for debugging. tests/portable/check.sh checks
 # the packaged binaries (`make test-portable`, part of `make test`).
 # Installs what it needs when missing: zig and cargo-zigbuild (PyPI's prebuilt ziglang and
@@ -9,13 +9,12 @@
 # Debian's llvm (llvm-strip, llvm-objdump, llvm-nm, llvm-lipo) with apt-get when root.
 
 LINUX_TARGET := x86_64-unknown-linux-gnu.2.17
-LINUX_SO := target/x86_64-unknown-linux-gnu/release/libgear_rattle.so
 DARWIN_ARCHS := x86_64 aarch64
-DARWIN_SLICES := $(foreach a,$(DARWIN_ARCHS),target/$(a)-apple-darwin/release/libgear_rattle.dylib)
+# $(call linux_so,CRATE), $(call darwin_slices,CRATE): the binaries cargo builds.
+linux_so = target/x86_64-unknown-linux-gnu/release/lib$(1).so
+darwin_slices = $(foreach a,$(DARWIN_ARCHS),target/$(a)-apple-darwin/release/lib$(1).dylib)
 
-FMU_DEPS += $(FMU_STRIPPED)/linux64/GearRattle.so $(FMU_STRIPPED)/darwin64/GearRattle.dylib
-PACKAGE_FLAGS += --lib $(FMU_STRIPPED)/linux64/GearRattle.so \
-	--darwin64 $(FMU_STRIPPED)/darwin64/GearRattle.dylib
+FMU_PLATFORMS += linux64:so darwin64:dylib
 TEST_TARGETS += test-portable
 
 .PHONY: zig-toolchain llvm-tools test-portable
@@ -32,26 +31,31 @@ ZIGBUILD = mkdir -p target && cd target && \
 	CARGO_ZIGBUILD_PYTHON_PATH=$(CURDIR)/$(PY) MACOSX_DEPLOYMENT_TARGET=11.0 \
 	$(CURDIR)/$(VENV)/bin/cargo-zigbuild rustc --manifest-path $(CURDIR)/Cargo.toml --release --lib --crate-type cdylib
 
-# cargo decides what to rebuild; these rules always ask it.
-$(LINUX_SO): FORCE | libclang zig-toolchain
-	$(ZIGBUILD) --target $(LINUX_TARGET)
+# The rules of one model $(1) whose crate is $(2). cargo decides what to rebuild; the rules
+# of its binaries always ask it. zig's Mach-O linker ignores rustc's exported-symbols list:
+# mk/darwin-link.py, set as the linker here, keeps the exports to fmi2* (cargo's --config
+# wins over cargo-zigbuild's setting). The unstripped copy of each binary that goes into the
+# FMU (the two darwin slices joined into one universal dylib), then the stripped one (below).
+define portable_rules
+$(call linux_so,$(2)): FORCE | libclang zig-toolchain
+	$$(ZIGBUILD) -p $(2) --target $(LINUX_TARGET)
 
-# zig's Mach-O linker ignores rustc's exported-symbols list: mk/darwin-link.py, set as the
-# linker here, keeps the exports to fmi2* (cargo's --config wins over cargo-zigbuild's setting).
-target/%-apple-darwin/release/libgear_rattle.dylib: FORCE | libclang zig-toolchain
-	$(ZIGBUILD) --target $*-apple-darwin --config 'target.$*-apple-darwin.linker="$(CURDIR)/mk/darwin-link.py"'
+target/%-apple-darwin/release/lib$(2).dylib: FORCE | libclang zig-toolchain
+	$$(ZIGBUILD) -p $(2) --target $$*-apple-darwin --config 'target.$$*-apple-darwin.linker="$(CURDIR)/mk/darwin-link.py"'
 
-# The unstripped copy of each binary that goes into the FMU (the two darwin slices joined into
-# one universal dylib), then the stripped one. llvm-strip also re-signs the arm64 slice (ad hoc,
-# as the linker did): macOS on Apple silicon loads no code whose signature does not match.
-$(FMU_DEBUG)/linux64/GearRattle.so: $(LINUX_SO)
+$(FMU_DEBUG)/linux64/$(1).so: $(call linux_so,$(2))
+
+$(FMU_DEBUG)/darwin64/$(1).dylib: $(call darwin_slices,$(2)) | llvm-tools
+	@mkdir -p $$(@D)
+	$$(LLVM_BIN)/llvm-lipo -create -output $$@ $$^
+endef
+$(foreach m,$(MODELS),$(eval $(call portable_rules,$(m),$(crate_$(m)))))
+
+# llvm-strip also re-signs the arm64 slice (ad hoc, as the linker did): macOS on Apple
+# silicon loads no code whose signature does not match.
 $(FMU_DEBUG)/%:
 	@mkdir -p $(@D)
 	cp $^ $@
-
-$(FMU_DEBUG)/darwin64/GearRattle.dylib: $(DARWIN_SLICES) | llvm-tools
-	@mkdir -p $(@D)
-	$(LLVM_BIN)/llvm-lipo -create -output $@ $^
 
 $(FMU_STRIPPED)/%: $(FMU_DEBUG)/% | llvm-tools
 	@mkdir -p $(@D)
@@ -59,15 +63,15 @@ $(FMU_STRIPPED)/%: $(FMU_DEBUG)/% | llvm-tools
 
 # zig exports the two names of the Mach-O header from every dylib: mk/darwin-exports.py takes
 # them out of the export trie, then llvm-strip lays the dylib out again and re-signs it.
-$(FMU_STRIPPED)/darwin64/GearRattle.dylib: $(FMU_DEBUG)/darwin64/GearRattle.dylib mk/darwin-exports.py | llvm-tools
+$(FMU_STRIPPED)/darwin64/%.dylib: $(FMU_DEBUG)/darwin64/%.dylib mk/darwin-exports.py | llvm-tools
 	@mkdir -p $(@D)
 	python3 mk/darwin-exports.py $< $@.fmi2
 	llvm-strip --strip-all -o $@ $@.fmi2
 	rm $@.fmi2
 
-## test-portable: the FMU's binaries: glibc 2.17, exports, linked libraries, no debug info, size
+## test-portable: the FMUs' binaries: glibc 2.17, exports, linked libraries, no debug info, size
 test-portable: fmu | llvm-tools
-	tests/portable/check.sh $(FMU)
+	$(foreach m,$(MODELS),tests/portable/check.sh target/fmu/$(m).fmu &&) true
 
 zig-toolchain: $(VENV)/.installed
 	@for a in $(DARWIN_ARCHS); do \

@@ -1,35 +1,38 @@
-# Windows: binaries/win64/GearRattle.dll in the FMU, cross-built with Rust's
+# Windows: binaries/win64/MODEL.dll in each FMU of MODELS (the Makefile), cross-built with Rust's
 # x86_64-pc-windows-gnu target and MinGW-w64 (linker: mk/windows-link.sh, set in
 # .cargo/config.toml), and tested under Wine against the linux64 binary (tests/windows/run.sh).
 # Installs what it needs when missing: the rustup target, and with apt-get when root
 # gcc-mingw-w64-x86-64 (for `make fmu`) and wine64 (for `make test-windows`).
 
 WIN_TARGET := x86_64-pc-windows-gnu
-WIN_DLL := target/$(WIN_TARGET)/release/gear_rattle.dll
+# $(call win_dll,CRATE): the DLL cargo builds.
+win_dll = target/$(WIN_TARGET)/release/$(1).dll
 
 # Packaged stripped, the unstripped copy in target/fmu/debug/win64 (rules in mk/portable.mk).
-FMU_DEPS += $(FMU_STRIPPED)/win64/GearRattle.dll
-PACKAGE_FLAGS += --win64 $(FMU_STRIPPED)/win64/GearRattle.dll
+FMU_PLATFORMS += win64:dll
 TEST_TARGETS += test-windows
 
 .PHONY: windows-toolchain windows-wine test-windows
 
 # fmi-sys's bindgen parses the FMI headers for the Windows target against MinGW's headers,
 # whose malloc.h needs clang's own include directory (mm_malloc.h) first. Built as a cdylib
-# alone, like the portable binaries (see mk/portable.mk).
-$(WIN_DLL): FORCE | libclang windows-toolchain
-	@mm_malloc=$$(ls /usr/lib/llvm-*/lib/clang/*/include/mm_malloc.h 2>/dev/null | sort -V | tail -n 1); \
-	[ -n "$$mm_malloc" ] || { echo "clang's mm_malloc.h not found (libclang-dev installs it)"; exit 1; }; \
-	export BINDGEN_EXTRA_CLANG_ARGS_x86_64_pc_windows_gnu="-I$$(dirname "$$mm_malloc")"; \
-	echo "BINDGEN_EXTRA_CLANG_ARGS_x86_64_pc_windows_gnu=$$BINDGEN_EXTRA_CLANG_ARGS_x86_64_pc_windows_gnu"; \
-	echo "cargo rustc --release --lib --crate-type cdylib --target $(WIN_TARGET)"; \
-	cargo rustc --release --lib --crate-type cdylib --target $(WIN_TARGET)
+# alone, like the portable binaries (see mk/portable.mk). The rules of model $(1), crate $(2).
+define windows_rules
+$(call win_dll,$(2)): FORCE | libclang windows-toolchain
+	@mm_malloc=$$$$(ls /usr/lib/llvm-*/lib/clang/*/include/mm_malloc.h 2>/dev/null | sort -V | tail -n 1); \
+	[ -n "$$$$mm_malloc" ] || { echo "clang's mm_malloc.h not found (libclang-dev installs it)"; exit 1; }; \
+	export BINDGEN_EXTRA_CLANG_ARGS_x86_64_pc_windows_gnu="-I$$$$(dirname "$$$$mm_malloc")"; \
+	echo "BINDGEN_EXTRA_CLANG_ARGS_x86_64_pc_windows_gnu=$$$$BINDGEN_EXTRA_CLANG_ARGS_x86_64_pc_windows_gnu"; \
+	echo "cargo rustc --release -p $(2) --lib --crate-type cdylib --target $(WIN_TARGET)"; \
+	cargo rustc --release -p $(2) --lib --crate-type cdylib --target $(WIN_TARGET)
 
-$(FMU_DEBUG)/win64/GearRattle.dll: $(WIN_DLL)
+$(FMU_DEBUG)/win64/$(1).dll: $(call win_dll,$(2))
+endef
+$(foreach m,$(MODELS),$(eval $(call windows_rules,$(m),$(crate_$(m)))))
 
-## test-windows: the win64 DLL under Wine agrees with the linux64 .so; its export/import tables
+## test-windows: the win64 DLLs under Wine agree with the linux64 .so; their export/import tables
 test-windows: fmu | windows-toolchain windows-wine
-	tests/windows/run.sh $(FMU)
+	$(foreach m,$(MODELS),tests/windows/run.sh target/fmu/$(m).fmu &&) true
 
 windows-toolchain:
 	@rustup target list --installed | grep -qx $(WIN_TARGET) || { \

@@ -110,7 +110,7 @@ pub struct Gearbox {
 }
 
 /// The loads at one instant, shared by the right-hand side and the readouts.
-pub(crate) struct Loads {
+pub struct Loads {
     pub flywheel: Shaft,
     /// θ_I, ω_I, α_I.
     pub input: Shaft,
@@ -274,7 +274,7 @@ impl Gearbox {
     /// The loads at (t, y) with the current stage and regions (GEARBOX.md §2, §3): the
     /// contact forces first, which with the damper give α_I, which drives every ξ_i''.
     #[inline]
-    pub(crate) fn loads(&self, t: f64, y: &State) -> Loads {
+    pub fn loads(&self, t: f64, y: &State) -> Loads {
         let flywheel = self.flywheel_at(t, y);
         let imposed = self.imposed_input().map(|p| p.at(t));
         let phi_dot = y[PHI_DOT];
@@ -325,7 +325,15 @@ impl System<N> for Gearbox {
     /// GEARBOX.md §3 in relative coordinates, with the quadratures of the energy balance.
     #[inline]
     fn rhs(&self, t: f64, y: &State) -> State {
-        let l = self.loads(t, y);
+        self.rhs_with(&self.loads(t, y), y)
+    }
+}
+
+impl Gearbox {
+    /// The right-hand side at y from the loads `l` there (a caller that reads the loads too
+    /// forms them once).
+    #[inline]
+    pub fn rhs_with(&self, l: &Loads, y: &State) -> State {
         let phi_dot = y[PHI_DOT];
         let mut f = [0.0; N];
         if self.imposed_input().is_none() {

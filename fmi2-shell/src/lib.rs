@@ -15,7 +15,7 @@
 //! - the types of the contract and the checks of a variable's setting ([`contract`]) and, for
 //!   build scripts, the generator of the model description and of the constants from the
 //!   contract TOML (`build`, feature "build"), and the variable tables of the documentation
-//!   ([`table`]).
+//!   ([`table`]); Model Exchange's vectors checked ([`vectors`]).
 
 #[cfg(feature = "build")]
 pub mod build;
@@ -38,6 +38,7 @@ pub mod status;
 pub mod table;
 pub mod time;
 pub mod values;
+pub mod vectors;
 
 #[cfg(feature = "runtime")]
 pub use fmi_sys::fmi2;

@@ -6,9 +6,10 @@
 use serde::{Deserialize, Serialize};
 
 use crate::contract::{self, Causality, Kind, LOG_CATEGORIES, VARIABLES, vr};
-use crate::model_exchange::{NX, NZ};
+use crate::model_exchange::NX;
 use crate::simulation::{self, Simulation};
 use fmi2_shell::values::Values;
+use fmi2_shell::vectors::{fill, states};
 use fmi2_shell::{
     EventInfo, FmiError, FmiResult, FmiState, Identity, Interface, Log, Slave, Status,
 };
@@ -35,6 +36,11 @@ pub struct Instance {
 }
 
 impl Instance {
+    /// The running gearbox, once initialised.
+    pub fn simulation(&self) -> Option<&Simulation> {
+        self.sim.as_ref()
+    }
+
     fn build(&self) -> FmiResult<Simulation> {
         let rtol = self.tolerance.unwrap_or(contract::DEFAULT_TOLERANCE);
         let model_exchange = self.interface == Interface::ModelExchange;
@@ -147,31 +153,6 @@ impl Instance {
                 stats.accepted, stats.implicit_steps, stats.rejected, stats.edges, stats.rhs_evals
             )
         });
-    }
-}
-
-/// Copies a vector of the model into the importer's array, refused if the lengths differ;
-/// a value that overflowed is fmi2Discard, which asks the importer for a smaller step.
-fn fill<const K: usize>(what: &str, out: &mut [f64], value: [f64; K]) -> FmiResult {
-    length(what, out.len(), K)?;
-    if let Some(bad) = value.iter().position(|v| !v.is_finite()) {
-        return Err(FmiError::discard(format!(
-            "{what}[{bad}] = {} at these states and time: beyond what the model can represent; take a smaller step",
-            value[bad]
-        )));
-    }
-    out.copy_from_slice(&value);
-    Ok(())
-}
-
-/// Checks the length of an importer's vector.
-fn length(what: &str, n: usize, expected: usize) -> FmiResult {
-    if n == expected {
-        Ok(())
-    } else {
-        Err(FmiError::error(format!(
-            "{what} has {n} elements: the model has {expected}"
-        )))
     }
 }
 
@@ -320,15 +301,8 @@ impl Slave for Instance {
     }
 
     fn set_continuous_states(&mut self, x: &[f64]) -> FmiResult {
-        length("x", x.len(), NX)?;
-        if let Some(bad) = x.iter().position(|v| !v.is_finite()) {
-            return Err(FmiError::error(format!(
-                "x[{bad}] = {} refused: the continuous states must be finite",
-                x[bad]
-            )));
-        }
-        self.sim_mut()
-            .set_continuous_states(x.try_into().expect("length checked"));
+        let x = states::<NX>(x)?;
+        self.sim_mut().set_continuous_states(x);
         Ok(())
     }
 
@@ -345,7 +319,6 @@ impl Slave for Instance {
     }
 
     fn get_event_indicators(&mut self, z: &mut [f64]) -> FmiResult {
-        length("eventIndicators", z.len(), NZ)?;
         fill("eventIndicators", z, self.current()?.event_indicators())
     }
 

@@ -10,7 +10,8 @@ use crate::windowed::{self, Windowed};
 use fmi2_shell::values::Values;
 use fmi2_shell::{FmiError, FmiResult};
 use gear_rattle::gearbox::{self, Drive, Gearbox, GearboxParams, LooseGear, PHI, State, xi};
-use gear_rattle::integrator::{Jacobian, Method, Piecewise, Solver, SolverError, Stats};
+use gear_rattle::instance::simulation::{Stepped, method};
+use gear_rattle::integrator::{Method, Solver, SolverError, Stats};
 use gear_rattle::physics::{
     DamperParams, Engine, EngineOrder, EngineParams, GearParams, Oil, Polynomial, Shaft,
 };
@@ -21,42 +22,17 @@ pub const EXCITATION_FLYWHEEL: i64 = 0;
 pub const EXCITATION_ENGINE: i64 = 1;
 pub const EXCITATION_INPUT_SIDE: i64 = 2;
 
-/// A piecewise system with its solver and its state.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Stepped<S, const N: usize> {
-    pub system: S,
-    pub solver: Solver<N>,
-    #[serde(with = "gear_rattle::integrator::serde_array")]
-    pub y: [f64; N],
-}
-
-impl<S: Piecewise<N> + Jacobian<N> + Copy, const N: usize> Stepped<S, N> {
-    /// Advances to t_end; on failure the system, its solver and t are left as they were. A
-    /// call served from the solver's kept step cannot fail and needs no copy to roll back
-    /// to (the solver of the windowed gearbox is some 150 KB).
-    fn advance_to(&mut self, t: &mut f64, t_end: f64) -> Result<(), SolverError> {
-        if self.solver.serve(&mut self.system, t, &mut self.y, t_end) {
-            return Ok(());
-        }
-        let (before, t_before) = (Box::new(*self), *t);
-        let advanced = self.solver.advance(&mut self.system, t, &mut self.y, t_end);
-        if advanced.is_err() {
-            (*self, *t) = (*before, t_before);
-        }
-        advanced
-    }
-}
-
-/// The gearbox before its statistics window opens, and with it.
-#[allow(clippy::large_enum_variant)]
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+/// The gearbox before its statistics window opens, and with it. Boxed: their solvers are
+/// some 60 and 145 KB, which an instance, its FMU states and their decoding keep off the
+/// stack (an importer's thread may have 1 MB).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub enum Run {
-    Lean(Stepped<Gearbox, { gearbox::N }>),
-    Windowed(Stepped<Windowed, { windowed::N }>),
+    Lean(Box<Stepped<Gearbox, { gearbox::N }>>),
+    Windowed(Box<Stepped<Windowed, { windowed::N }>>),
 }
 
 /// An initialised gearbox being stepped.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Simulation {
     pub run: Run,
     pub t: f64,
@@ -164,16 +140,6 @@ fn drive(values: &Values, params: &GearboxParams, t0: f64) -> Drive {
     }
 }
 
-/// The integration method the `solver` parameter asks for.
-fn method(values: &Values) -> Method {
-    match values.integer(vr::solver) {
-        0 => Method::Auto,
-        1 => Method::Explicit,
-        2 => Method::Implicit,
-        other => unreachable!("solver = {other} is outside the contract's range"),
-    }
-}
-
 /// `$body` with `$k` the stepped system of `$run`, whichever it is.
 macro_rules! on_run {
     ($run:expr, $k:ident => $body:expr) => {
@@ -208,12 +174,12 @@ impl Simulation {
         }
         let mut system = Gearbox::new(&params, drive, &y);
         system.set_output_speed(values.real(vr::omega_out));
-        let method = method(values);
+        let method = method(values.integer(vr::solver));
         let interpolate_ends = matches!(drive, Drive::Engine(_));
         let mut solver = Solver::with_method(system.tolerance(rtol), method);
         solver.interpolate_ends = interpolate_ends;
         let mut sim = Simulation {
-            run: Run::Lean(Stepped { system, solver, y }),
+            run: Run::Lean(Box::new(Stepped { system, solver, y })),
             t: t0,
             window_from: values.real(vr::stats_from).max(t0),
             rtol,
@@ -237,19 +203,19 @@ impl Simulation {
         let mut solver = Solver::with_method(system.tolerance(self.rtol), self.method);
         solver.interpolate_ends = self.interpolate_ends;
         solver.stats = k.solver.stats;
-        self.run = Run::Windowed(Stepped { system, solver, y });
+        self.run = Run::Windowed(Box::new(Stepped { system, solver, y }));
     }
 
     /// Advances to t_end, through the window's opening on the way. On failure the
     /// simulation is left as it was.
     pub fn step_to(&mut self, t_end: f64) -> Result<(), SolverError> {
         if matches!(self.run, Run::Lean(_)) && self.window_from <= t_end {
-            let before = Box::new(*self);
+            let before = self.clone();
             let opened = self
                 .advance_to(self.window_from)
                 .map(|()| self.open_window());
             if let Err(e) = opened.and_then(|()| self.advance_to(t_end)) {
-                *self = *before;
+                *self = before;
                 return Err(e);
             }
         } else {

@@ -72,12 +72,12 @@ impl Windowed {
     /// Each gear's pitch-line acceleration |r_L α_L| at (t, y), for the gears whose ξ lies
     /// in its current piece (a point past an edge is not the piece's).
     fn accelerations(&self, t: f64, y: &State) -> [Option<f64>; MAX_GEARS] {
-        let r = self.inner.readout(t, y);
+        let l = self.inner.loads(t, y);
         std::array::from_fn(|i| {
             let gear = &self.inner.gears[i];
             let (lo, hi) = gear.dynamics.law.bounds(gear.region);
             (i < self.inner.n_gears() && (lo..=hi).contains(&y[xi(i)]))
-                .then(|| (gear.dynamics.params.r_L * r.gears[i].alpha_L).abs())
+                .then(|| (gear.dynamics.params.r_L * l.gears[i].alpha_L).abs())
         })
     }
 }
@@ -94,13 +94,13 @@ pub fn quadratures(y: &[f64; N], i: usize) -> Quadratures {
 impl System<N> for Windowed {
     fn rhs(&self, t: f64, y: &[f64; N]) -> [f64; N] {
         let h = head(y);
+        let l = self.inner.loads(t, &h);
         let mut f = [0.0; N];
-        f[..gearbox::N].copy_from_slice(&self.inner.rhs(t, &h));
-        let r = self.inner.readout(t, &h);
+        f[..gearbox::N].copy_from_slice(&self.inner.rhs_with(&l, &h));
         for (i, gear) in self.inner.gears[..self.inner.n_gears()].iter().enumerate() {
-            let g = &r.gears[i];
-            let a = gear.dynamics.params.r_L * g.alpha_L;
-            f[a2(i)..a2(i) + 3].copy_from_slice(&[a * a, g.F, g.F * g.F]);
+            let g = &l.gears[i];
+            let (a, force) = (gear.dynamics.params.r_L * g.alpha_L, g.force.total());
+            f[a2(i)..a2(i) + 3].copy_from_slice(&[a * a, force, force * force]);
         }
         f
     }

@@ -1,15 +1,22 @@
 //! `documentation/index.html` inside GearRattle's FMU: the equations of MODEL.md with the
 //! paper's numbers, and the parameter and variable tables generated from the contract.
 
-use crate::contracts::gear_rattle::{Causality, VARIABLES};
+use crate::contracts::gear_rattle::{Causality, VARIABLES, Variable};
 
-const HEAD: &str = r#"<!DOCTYPE html>
-<html lang="en"><head><meta charset="utf-8"><title>GearRattle</title>
-<style>body{font-family:sans-serif;max-width:60em;margin:2em auto;line-height:1.4}
-table{border-collapse:collapse}td,th{border:1px solid #bbb;padding:.2em .5em;text-align:left}
-code,pre{background:#f4f4f4}</style></head><body>
-<h1>GearRattle</h1>
-<p>A loose gear rattling in its backlash against a main shaft, after J.-L. Dion, S. Le Moyne,
+/// The start of a model's page up to its title.
+pub fn head(model: &str) -> String {
+    format!(
+        r#"<!DOCTYPE html>
+<html lang="en"><head><meta charset="utf-8"><title>{model}</title>
+<style>body{{font-family:sans-serif;max-width:60em;margin:2em auto;line-height:1.4}}
+table{{border-collapse:collapse}}td,th{{border:1px solid #bbb;padding:.2em .5em;text-align:left}}
+code,pre{{background:#f4f4f4}}</style></head><body>
+<h1>{model}</h1>
+"#
+    )
+}
+
+const HEAD: &str = r#"<p>A loose gear rattling in its backlash against a main shaft, after J.-L. Dion, S. Le Moyne,
 G. Chevallier, H. Sebbah, <i>Gear impacts and idle gear noise: experimental study and non-linear
 dynamic model</i>, Mechanical Systems and Signal Processing 23(8), 2009, pp. 2608-2628.
 FMI 2.0 Co-Simulation and Model Exchange. In Co-Simulation the solver is inside (adaptive Dormand-Prince 5(4) with error control,
@@ -90,17 +97,25 @@ ex.simulate_until(target_time=500_000_000)                      # 0.5 s</pre>
 /// The work-precision plot of `make bench` (docs/work_precision.png), shown on the page.
 pub const WORK_PRECISION_PNG: &[u8] = include_bytes!("../../docs/work_precision.png");
 
-fn table(title: &str, causality: Causality) -> String {
-    fmi2_shell::table::html(title, VARIABLES, causality)
+/// The tables of a model's parameters, inputs, outputs and Model Exchange locals, generated
+/// from its contract's variables.
+pub fn tables(variables: &[Variable]) -> String {
+    [
+        ("Parameters", Causality::Parameter),
+        ("Inputs", Causality::Input),
+        ("Outputs", Causality::Output),
+        ("Model Exchange states and derivatives", Causality::Local),
+    ]
+    .iter()
+    .map(|&(title, causality)| fmi2_shell::table::html(title, variables, causality))
+    .collect()
 }
 
 /// The whole page.
 pub fn index_html() -> String {
-    let mut html = HEAD.to_string();
-    html += &table("Parameters", Causality::Parameter);
-    html += &table("Inputs", Causality::Input);
-    html += &table("Outputs", Causality::Output);
-    html += &table("Model Exchange states and derivatives", Causality::Local);
-    html + "<p>The defaults are the paper's model values (§7), including its 25 µm model backlash; \
+    head("GearRattle")
+        + HEAD
+        + &tables(VARIABLES)
+        + "<p>The defaults are the paper's model values (§7), including its 25 µm model backlash; \
 the paper's measurements suggest an actual backlash near 80 µm.</p>\n</body></html>\n"
 }

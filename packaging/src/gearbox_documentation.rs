@@ -1,15 +1,9 @@
 //! `documentation/index.html` inside GearboxRattle's FMU: the model of docs/GEARBOX.md in
 //! short, and the parameter and variable tables generated from its contract.
 
-use crate::contracts::gearbox_rattle::{Causality, VARIABLES};
+use crate::contracts::gearbox_rattle::VARIABLES;
 
-const HEAD: &str = r#"<!DOCTYPE html>
-<html lang="en"><head><meta charset="utf-8"><title>GearboxRattle</title>
-<style>body{font-family:sans-serif;max-width:60em;margin:2em auto;line-height:1.4}
-table{border-collapse:collapse}td,th{border:1px solid #bbb;padding:.2em .5em;text-align:left}
-code,pre{background:#f4f4f4}</style></head><body>
-<h1>GearboxRattle</h1>
-<p>The loose gears (1 to 8, <code>n_gears</code>) of a manual gearbox rattling at idle, each
+const HEAD: &str = r#"<p>The loose gears (1 to 8, <code>n_gears</code>) of a manual gearbox rattling at idle, each
 with the contact law of J.-L. Dion et al. (Mechanical Systems and Signal Processing 23(8),
 2009), on an input side driven through a two-stage clutch damper. FMI 2.0 Co-Simulation
 with the solver inside (adaptive Dormand-Prince 5(4), handing over to Radau IIA while the
@@ -44,16 +38,8 @@ r = simulate_fmu("GearboxRattle.fmu", stop_time=1.0, output_interval=1e-3,
                  output=["phi", "gear[1].impacts_Fplus", "stat_rattle_power"])</pre>
 "#;
 
-fn table(title: &str, causality: Causality) -> String {
-    fmi2_shell::table::html(title, VARIABLES, causality)
-}
-
 /// The whole page.
 pub fn index_html() -> String {
-    let mut html = HEAD.to_string();
-    html += &table("Parameters", Causality::Parameter);
-    html += &table("Inputs", Causality::Input);
-    html += &table("Outputs", Causality::Output);
-    html += &table("Model Exchange states and derivatives", Causality::Local);
-    html + "</body></html>\n"
+    use crate::documentation::{head, tables};
+    head("GearboxRattle") + HEAD + &tables(VARIABLES) + "</body></html>\n"
 }

@@ -14,6 +14,7 @@ use crate::contract::{self, Causality, Kind, LOG_CATEGORIES, vr};
 use crate::physics::Shaft;
 use crate::rattle::Impacts;
 use fmi2_shell::values::Values;
+use fmi2_shell::vectors::{fill, states};
 use fmi2_shell::{EventInfo, Identity, Interface, Log, Slave};
 use model_exchange::NX;
 use serde::{Deserialize, Serialize};
@@ -44,21 +45,6 @@ pub struct Instance {
     /// Log categories switched on and lines waiting for the importer's logger.
     #[serde(skip)]
     log: Log,
-}
-
-/// Copies a vector of the model into the importer's array, refused if the lengths differ.
-/// A value that overflowed (states or a time beyond what the model can represent) is
-/// fmi2Discard, which asks the importer's solver for a smaller step (FMI 2.0 §2.1.3).
-fn fill<const K: usize>(what: &str, out: &mut [f64], value: [f64; K]) -> FmiResult {
-    Instance::length(what, out.len(), K)?;
-    if let Some(bad) = value.iter().position(|v| !v.is_finite()) {
-        return Err(FmiError::discard(format!(
-            "{what}[{bad}] = {} at these states and time: they are beyond what the model can represent; take a smaller step",
-            value[bad]
-        )));
-    }
-    out.copy_from_slice(&value);
-    Ok(())
 }
 
 impl Instance {
@@ -158,17 +144,6 @@ impl Instance {
     /// The running simulation, for the calls of Model Exchange.
     fn model_exchange(&mut self) -> &mut Simulation {
         self.sim.as_mut().expect("initialised")
-    }
-
-    /// Checks the length of an importer's vector.
-    fn length(what: &str, n: usize, expected: usize) -> FmiResult {
-        if n == expected {
-            Ok(())
-        } else {
-            Err(FmiError::error(format!(
-                "{what} has {n} elements: the model has {expected}"
-            )))
-        }
     }
 
     /// Main inputs coherent with the previous values: `theta_M` and `omega_M` (inputs mode)
@@ -561,15 +536,8 @@ impl Slave for Instance {
     }
 
     fn set_continuous_states(&mut self, x: &[f64]) -> FmiResult {
-        Self::length("x", x.len(), NX)?;
-        if let Some(bad) = x.iter().position(|v| !v.is_finite()) {
-            return Err(FmiError::error(format!(
-                "x[{bad}] = {} refused: the continuous states must be finite",
-                x[bad]
-            )));
-        }
-        self.model_exchange()
-            .set_continuous_states(x.try_into().expect("length checked"));
+        let x = states::<NX>(x)?;
+        self.model_exchange().set_continuous_states(x);
         Ok(())
     }
 

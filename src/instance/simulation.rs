@@ -47,6 +47,23 @@ pub struct Stepped<S, const N: usize> {
     pub y: [f64; N],
 }
 
+impl<S: Piecewise<N> + Jacobian<N> + Copy, const N: usize> Stepped<S, N> {
+    /// Advances to t_end; on failure the system, its solver and t are left as they were. A
+    /// call served from the solver's kept step cannot fail and needs no copy to roll back to
+    /// (at 10 µs communication steps most are).
+    pub fn advance_to(&mut self, t: &mut f64, t_end: f64) -> Result<(), SolverError> {
+        if self.solver.serve(&mut self.system, t, &mut self.y, t_end) {
+            return Ok(());
+        }
+        let (before, t_before) = (*self, *t);
+        let advanced = self.solver.advance(&mut self.system, t, &mut self.y, t_end);
+        if advanced.is_err() {
+            (*self, *t) = (before, t_before);
+        }
+        advanced
+    }
+}
+
 impl<S: GearPair<N> + Jacobian<N> + Copy, const N: usize> Stepped<S, N> {
     /// Advances to t_end, through the opening of the statistics window on the way, where its
     /// quadratures are kept; on failure the pair, its solver and t are left as they were.
@@ -87,21 +104,6 @@ impl<S: GearPair<N> + Jacobian<N> + Copy, const N: usize> Stepped<S, N> {
     pub(super) fn open_window(&mut self) {
         let q = S::quadratures(&self.y);
         self.system.window_mut().open(q);
-    }
-
-    /// Advances to t_end; on failure the pair, its solver and t are left as they were. A
-    /// call served from the solver's kept step cannot fail and needs no copy to roll back to
-    /// (at 10 µs communication steps most are).
-    fn advance_to(&mut self, t: &mut f64, t_end: f64) -> Result<(), SolverError> {
-        if self.solver.serve(&mut self.system, t, &mut self.y, t_end) {
-            return Ok(());
-        }
-        let (before, t_before) = (*self, *t);
-        let advanced = self.solver.advance(&mut self.system, t, &mut self.y, t_end);
-        if advanced.is_err() {
-            (*self, *t) = (before, t_before);
-        }
-        advanced
     }
 
     fn now(&self) -> Now<'_> {
@@ -246,9 +248,10 @@ pub fn gear_params(values: &Values) -> GearParams {
     }
 }
 
-/// The integration method the `solver` parameter asks for (checked against its range).
-fn method(values: &Values) -> Method {
-    match values.integer(vr::solver) {
+/// The integration method the `solver` parameter asks for (checked against its range; the
+/// gearbox's contract numbers them alike).
+pub fn method(solver: i64) -> Method {
+    match solver {
         0 => Method::Auto,
         1 => Method::Explicit,
         2 => Method::Implicit,
@@ -292,7 +295,7 @@ impl Simulation {
             },
             other => unreachable!("excitation = {other} is outside the contract's range"),
         };
-        let method = method(values);
+        let method = method(values.integer(vr::solver));
         let dynamics = Dynamics::new(params);
         let xi = gap_start * params.G;
         // A negative stats_from opens no window: the kinematic state then carries none of its

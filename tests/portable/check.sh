@@ -12,12 +12,14 @@
 # The pytest suite and tests/windows/run.sh run the linux64 binary of the same FMU.
 # Every problem fails the test with a message; nothing is skipped.
 #
-# Usage: tests/portable/check.sh [FMU]   (default target/fmu/GearRattle.fmu)
+# Usage: tests/portable/check.sh [FMU]   (default target/fmu/GearRattle.fmu; the binaries are
+# named after the FMU's file, binaries/linux64/GearboxRattle.so in GearboxRattle.fmu)
 set -euo pipefail
 
 ROOT=$(cd "$(dirname "$0")/../.." && pwd)
 FMU=$(realpath -m "${1:-$ROOT/target/fmu/GearRattle.fmu}")
-WORK=$ROOT/target/portable-test
+MODEL=$(basename "$FMU" .fmu)
+WORK=$ROOT/target/portable-test/$MODEL
 MAX_GLIBC=2.17
 MAX_MACOS=11.0
 MAX_BYTES=$((1024 * 1024))
@@ -35,9 +37,9 @@ done
 [ -f "$FMU" ] || { fail "$FMU does not exist: build it with 'make fmu'"; exit 1; }
 rm -rf "$WORK" && mkdir -p "$WORK"
 python3 -m zipfile -e "$FMU" "$WORK/fmu" || { fail "$FMU is not a readable zip file"; exit 1; }
-SO=$WORK/fmu/binaries/linux64/GearRattle.so
-DYLIB=$WORK/fmu/binaries/darwin64/GearRattle.dylib
-DLL=$WORK/fmu/binaries/win64/GearRattle.dll
+SO=$WORK/fmu/binaries/linux64/$MODEL.so
+DYLIB=$WORK/fmu/binaries/darwin64/$MODEL.dylib
+DLL=$WORK/fmu/binaries/win64/$MODEL.dll
 for bin in "$SO" "$DYLIB" "$DLL"; do
     [ -f "$bin" ] || { fail "$FMU has no ${bin#"$WORK/fmu/"}"; exit 1; }
 done
@@ -124,4 +126,4 @@ if [ "$failures" -gt 0 ]; then
     echo "test-portable: $failures check(s) failed" >&2
     exit 1
 fi
-step "OK: linux64, darwin64 and win64 binaries are portable, stripped and export only fmi2*"
+step "OK: $MODEL's linux64, darwin64 and win64 binaries are portable, stripped and export only fmi2*"

@@ -1,13 +1,15 @@
-/* Steps GearRattle's binary as an FMI 2.0 importer does, without any FMI library: load it
+/* Steps an FMU's binary as an FMI 2.0 importer does, without any FMI library: load it
  * (LoadLibrary on Windows, dlopen elsewhere), instantiate with the GUID given, set
- * excitation = 1 (sine mode; the other parameters keep their defaults: scene S1 of the
- * paper), step to t_end with fixed communication steps, print xi and the impact counters.
+ * excitation = 1 (GearRattle: the sine mode, the other parameters keep their defaults: scene
+ * S1 of the paper; GearboxRattle: the built-in engine at idle), step to t_end with fixed
+ * communication steps, print xi and the impact counters (GearboxRattle: gear 1's).
  *
  * Built twice by tests/windows/run.sh from this one file: with MinGW-w64 for the win64 DLL
  * (run under Wine) and with gcc for the linux64 .so, so that both binaries of the FMU are
  * driven by the same code and their results can be compared.
  *
- * Usage: fmu_run LIBRARY GUID T_END DT
+ * Usage: fmu_run LIBRARY GUID T_END DT [VR_G VR_XI VR_EXCITATION VR_IMPACTS_FPLUS VR_IMPACTS_FMINUS]
+ * (the value references of those variables; GearRattle's by default)
  * Output (one line): xi=<%.17g> G=<%.17g> impacts_Fplus=<n> impacts_Fminus=<n> steps=<n>
  * Exit status: 0, or 1 as soon as a call does not answer fmi2OK (the reason on stderr). */
 
@@ -61,7 +63,9 @@ typedef fmi2Status (*DoStep)(fmi2Component, fmi2Real, fmi2Real, fmi2Boolean);
 typedef void (*FreeInstance)(fmi2Component);
 
 /* Value references (modelDescription/GearRattle.toml). */
-enum { VR_G = 7, VR_XI = 34, VR_EXCITATION = 100, VR_IMPACTS_FPLUS = 102, VR_IMPACTS_FMINUS = 103 };
+/* GearRattle's value references of G, xi, excitation, impacts_Fplus, impacts_Fminus. */
+enum { VR_G, VR_XI, VR_EXCITATION, VR_IMPACTS_FPLUS, VR_IMPACTS_FMINUS, VRS };
+static fmi2ValueReference vrs[VRS] = {7, 34, 100, 102, 103};
 
 static void logger(fmi2ComponentEnvironment env, fmi2String instance, fmi2Status status,
                    fmi2String category, fmi2String message, ...) {
@@ -93,9 +97,13 @@ static void check(fmi2Status status, const char *call) {
 }
 
 int main(int argc, char **argv) {
-    if (argc != 5) {
-        fprintf(stderr, "usage: %s LIBRARY GUID T_END DT\n", argv[0]);
+    if (argc != 5 && argc != 5 + VRS) {
+        fprintf(stderr, "usage: %s LIBRARY GUID T_END DT [VR_G VR_XI VR_EXCITATION VR_IMPACTS_FPLUS VR_IMPACTS_FMINUS]\n",
+                argv[0]);
         return 2;
+    }
+    for (int k = 0; argc == 5 + VRS && k < VRS; k++) {
+        vrs[k] = (fmi2ValueReference)strtoul(argv[5 + k], NULL, 10);
     }
     const char *path = argv[1], *guid = argv[2];
     double t_end = atof(argv[3]), dt = atof(argv[4]);
@@ -127,7 +135,7 @@ int main(int argc, char **argv) {
         fprintf(stderr, "fmi2Instantiate returned NULL (GUID %s)\n", guid);
         return 1;
     }
-    const fmi2ValueReference excitation_vr = VR_EXCITATION;
+    const fmi2ValueReference excitation_vr = vrs[VR_EXCITATION];
     const fmi2Integer sine = 1;
     check(set_integer(c, &excitation_vr, 1, &sine), "fmi2SetInteger(excitation)");
     check(setup(c, 0, 0.0, 0.0, 1, t_end), "fmi2SetupExperiment");
@@ -138,8 +146,8 @@ int main(int argc, char **argv) {
         check(do_step(c, i * dt, dt, 1), "fmi2DoStep");
     }
 
-    const fmi2ValueReference real_vrs[2] = {VR_XI, VR_G};
-    const fmi2ValueReference int_vrs[2] = {VR_IMPACTS_FPLUS, VR_IMPACTS_FMINUS};
+    const fmi2ValueReference real_vrs[2] = {vrs[VR_XI], vrs[VR_G]};
+    const fmi2ValueReference int_vrs[2] = {vrs[VR_IMPACTS_FPLUS], vrs[VR_IMPACTS_FMINUS]};
     fmi2Real reals[2];
     fmi2Integer ints[2];
     check(get_real(c, real_vrs, 2, reals), "fmi2GetReal");

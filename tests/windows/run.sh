@@ -1,13 +1,15 @@
 #!/usr/bin/env bash
 # The win64 binary of the FMU, checked on Linux (run by `make test-windows`, part of `make test`):
-#   1. the FMU carries binaries/win64/GearRattle.dll beside binaries/linux64/GearRattle.so;
+#   1. the FMU carries binaries/win64/MODEL.dll beside binaries/linux64/MODEL.so, MODEL the
+#      FMU's file name (GearRattle, GearboxRattle);
 #   2. the DLL's export table is exactly the FMI 2.0 Co-Simulation and Model Exchange
 #      functions, and its import
 #      table names only DLLs that a plain Windows 10 has;
 #   3. fmu_run.c, built with MinGW-w64 and run under Wine, steps the DLL through scene S1
-#      (sine mode, the paper's defaults) to 0.2 s in 1 ms communication steps; the same C file
-#      built with gcc steps the linux64 .so the same way; xi must agree within 1e-6 G and the
-#      impact counters exactly.
+#      (GearRattle: sine mode, the paper's defaults; GearboxRattle: its defaults, the engine at
+#      idle, gear 1 read) to 0.2 s in 1 ms communication steps; the same C file built with gcc
+#      steps the linux64 .so the same way; xi must agree within 1e-6 G and the impact counters
+#      exactly.
 # Every problem fails the test with a message; nothing is skipped.
 #
 # Usage: tests/windows/run.sh [FMU]   (default target/fmu/GearRattle.fmu)
@@ -16,6 +18,7 @@ set -euo pipefail
 ROOT=$(cd "$(dirname "$0")/../.." && pwd)
 HERE=$ROOT/tests/windows
 FMU=$(realpath -m "${1:-$ROOT/target/fmu/GearRattle.fmu}")
+MODEL=$(basename "$FMU" .fmu)
 WORK=$ROOT/target/windows-test
 T_END=0.2
 DT=0.001
@@ -40,10 +43,10 @@ done
 rm -rf "$WORK/run"
 mkdir -p "$WORK/run"
 python3 -m zipfile -e "$FMU" "$WORK/run/fmu" || fail "$FMU is not a readable zip file"
-DLL=$WORK/run/fmu/binaries/win64/GearRattle.dll
-SO=$WORK/run/fmu/binaries/linux64/GearRattle.so
-[ -f "$DLL" ] || fail "$FMU has no binaries/win64/GearRattle.dll"
-[ -f "$SO" ] || fail "$FMU has no binaries/linux64/GearRattle.so"
+DLL=$WORK/run/fmu/binaries/win64/$MODEL.dll
+SO=$WORK/run/fmu/binaries/linux64/$MODEL.so
+[ -f "$DLL" ] || fail "$FMU has no binaries/win64/$MODEL.dll"
+[ -f "$SO" ] || fail "$FMU has no binaries/linux64/$MODEL.so"
 if find "$WORK/run/fmu" -iname "bcryptprimitives*" | grep -q .; then
     fail "$FMU carries a bcryptprimitives.dll: the ProcessPrng stand-in is for the Wine test only"
 fi
@@ -86,10 +89,16 @@ step "imports: $(echo $imports) (all part of Windows 10)"
 CFLAGS="-O2 -std=c11 -Wall -Wextra -Werror"
 gcc $CFLAGS -o "$WORK/run/fmu_run" "$HERE/fmu_run.c" -ldl
 x86_64-w64-mingw32-gcc $CFLAGS -o "$WORK/run/fmu_run.exe" "$HERE/fmu_run.c"
-# For Wine only (see processprng.c): found beside fmu_run.exe when GearRattle.dll is loaded.
+# For Wine only (see processprng.c): found beside fmu_run.exe when the DLL is loaded.
 x86_64-w64-mingw32-gcc $CFLAGS -shared -o "$WORK/run/bcryptprimitives.dll" "$HERE/processprng.c" -ladvapi32
 
-linux=$("$WORK/run/fmu_run" "$SO" "$GUID" $T_END $DT) || fail "the linux64 run failed"
+# The value references fmu_run reads and sets (G, xi, excitation, impacts_Fplus, impacts_Fminus).
+case $MODEL in
+GearRattle) VRS="7 34 100 102 103" ;;
+GearboxRattle) VRS="1105 1120 2 1102 1103" ;; # gear[1]'s
+*) fail "no value references for $MODEL in tests/windows/run.sh" ;;
+esac
+linux=$("$WORK/run/fmu_run" "$SO" "$GUID" $T_END $DT $VRS) || fail "the linux64 run failed"
 echo "  linux64: $linux"
 
 export WINEPREFIX=$WORK/wine-prefix WINEDEBUG=-all,err+module WINEDLLOVERRIDES="mscoree,mshtml,winemenubuilder.exe="
@@ -100,7 +109,7 @@ if [ ! -f "$WINEPREFIX/system.reg" ]; then
         { cat "$WORK/wineboot.log" >&2; fail "wineboot failed or timed out"; }
 fi
 winpath="Z:${DLL//\//\\}"
-windows=$(cd "$WORK/run" && timeout 90 "$WINE" ./fmu_run.exe "$winpath" "$GUID" $T_END $DT | tr -d '\r') ||
+windows=$(cd "$WORK/run" && timeout 90 "$WINE" ./fmu_run.exe "$winpath" "$GUID" $T_END $DT $VRS | tr -d '\r') ||
     fail "the win64 run under Wine failed (messages above)"
 echo "  win64:   $windows"
 
@@ -117,4 +126,4 @@ awk -v a="$(field xi "$linux")" -v b="$(field xi "$windows")" -v g="$(field G "$
     printf "  |xi(linux64) - xi(win64)| = %.3g m (limit 1e-6 G = %.3g m)\n", d, 1e-6 * g
     exit !(g > 0 && d <= 1e-6 * g)
 }' || fail "xi differs by more than 1e-6 G between linux64 and win64"
-step "OK: win64 under Wine agrees with linux64 (S1, $T_END s, dt $DT s)"
+step "OK: $MODEL's win64 under Wine agrees with linux64 ($T_END s, dt $DT s)"
