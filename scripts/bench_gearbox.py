@@ -8,6 +8,7 @@ docs/gearbox_cost.png (gearrattle.gearbox_bench).
 import argparse
 import os
 import re
+import shutil
 import sys
 import time
 
@@ -23,6 +24,7 @@ BEGIN, END = "<!-- bench-gearbox:begin -->", "<!-- bench-gearbox:end -->"
 def rattle_map(x, y, out):
     """gearrattle-study map of the box (2 s per point, 2 workers): (points, wall time, exit code)."""
     nx, ny = (int(a.rsplit(":", 1)[1]) for a in (x, y))
+    shutil.rmtree(out, ignore_errors=True)  # else the study resumes the points it finds there
     t0 = time.perf_counter()
     code = study(["map", "--fmu", str(GF.GEARBOX_FMU), "--x", x, "--y", y, "--duration", "2",
                   "--stats-from", "0.5", "--workers", "2", "--quiet", "--out", out])
