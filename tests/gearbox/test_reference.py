@@ -8,7 +8,7 @@ import pytest
 
 from gearrattle import gearbox_fmu as GF
 from gearrattle import gearbox_reference as R
-from support.gearbox import RATE_SPREAD, WINDOW, counts_away_from_impacts, scene_start
+from support.gearbox import RATE_SPREAD, WINDOW, counts_away_from_impacts, reference_scene, scene_start
 
 T_END, DT = 2.0, 1e-4
 # The FMU's tolerance, its error well below 1e-4 G over the windows: co-simulation's own
@@ -26,7 +26,7 @@ def _runs(box_run, box_md, scene, fmi_type):
     out an output point that an event falls on)."""
     if fmi_type == "ModelExchange" and box_md.modelExchange is None:
         pytest.fail("the FMU does not offer Model Exchange yet", pytrace=False)
-    fmu, ref = box_run(T_END, DT, fmi_type, TOL[fmi_type], **scene_start(scene)), R.scene(scene, T_END, DT)
+    fmu, ref = box_run(T_END, DT, fmi_type, TOL[fmi_type], **scene_start(scene)), reference_scene(scene, T_END, DT)
     ix = np.round(fmu["time"] / DT).astype(int)
     assert np.allclose(fmu["time"], ref.t[ix], rtol=0, atol=1e-12) and ix.size >= 0.999 * ref.t.size
     return fmu, ref, ix
