@@ -27,6 +27,10 @@ pub mod math;
 pub mod physics;
 pub mod rattle;
 
+/// Whether this build carries GearRattle's fmi2* exports (the default feature `fmu`): a
+/// library that links this crate for the model only (gearbox/) must be built without them.
+pub const FMU_EXPORTS: bool = cfg!(feature = "fmu");
+
 #[cfg(feature = "fmu")]
 fmi2_shell::export_co_simulation!(crate::instance::Instance);
 #[cfg(feature = "fmu")]

@@ -276,11 +276,23 @@ pub(crate) fn step_peak<S: GearPair<N>, D: Dense<N>, const N: usize>(
         };
         return (first.max(a_end), a_end);
     }
-    let mut points = [(0.0, a0), (0.5, a_at(0.5)), (1.0, a_end)];
-    let mut peak = a0.max(points[1].1).max(a_end);
+    let points = [(0.0, a0), (0.5, a_at(0.5)), (1.0, a_end)];
+    (refine_peak(points, window.a_peak, a_at), a_end)
+}
+
+/// The largest of |a| at three points (θ, |a|) of a step, θ = 0, ½, 1, and of the values
+/// `a_at` gives where the parabola through the three around the largest so far peaks inside
+/// the step above both that largest and `floor` (the window's peak so far): successive
+/// parabolic interpolation, [`PEAK_ITERATIONS`] vertices at most.
+pub fn refine_peak(
+    mut points: [(f64, f64); 3],
+    floor: f64,
+    mut a_at: impl FnMut(f64) -> f64,
+) -> f64 {
+    let mut peak = points[0].1.max(points[1].1).max(points[2].1);
     for _ in 0..PEAK_ITERATIONS {
         let Some(theta) = parabola_peak(&points)
-            .filter(|&(x, y)| (0.0..=1.0).contains(&x) && y > peak.max(window.a_peak))
+            .filter(|&(x, y)| (0.0..=1.0).contains(&x) && y > peak.max(floor))
             .map(|(x, _)| x)
         else {
             break;
@@ -295,7 +307,7 @@ pub(crate) fn step_peak<S: GearPair<N>, D: Dense<N>, const N: usize>(
             .unwrap_or(1);
         points = [all[best - 1], all[best], all[best + 1]];
     }
-    (peak, a_end)
+    peak
 }
 
 /// Vertices of successive parabolas tried per step: each adds about three correct digits to

@@ -342,14 +342,32 @@ impl Slave for Instance {
     }
 
     /// A decoded state must be one this build can run: an initialised instance has its
-    /// simulation, and the values their full length and finite.
+    /// simulation, of its interface, with 1 to 8 gears and a finite time and state; the
+    /// values their full length and finite.
     fn check_decoded(&self, state: FmiState) -> FmiResult {
         self.values.check(VARIABLES)?;
-        if state.is_initialised() && self.sim.is_none() {
-            return Err(FmiError::error(format!(
+        let refuse = |why: String| Err(FmiError::error(why));
+        match &self.sim {
+            None if state.is_initialised() => refuse(format!(
                 "an initialised instance (state {state:?}) without a simulation"
-            )));
+            )),
+            Some(sim) => {
+                let (gearbox, y) = sim.gearbox();
+                let n = gearbox.n_gears();
+                if !(1..=gear_rattle::gearbox::MAX_GEARS).contains(&n) {
+                    refuse(format!("a gearbox of {n} gears"))
+                } else if sim.model_exchange != (self.interface == Interface::ModelExchange) {
+                    refuse(format!(
+                        "a {:?} instance with the other interface's simulation",
+                        self.interface
+                    ))
+                } else if !(sim.t.is_finite() && y.iter().all(|v| v.is_finite())) {
+                    refuse(format!("a time {} or a state that is not finite", sim.t))
+                } else {
+                    Ok(())
+                }
+            }
+            None => Ok(()),
         }
-        Ok(())
     }
 }

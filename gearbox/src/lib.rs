@@ -16,5 +16,13 @@ pub mod outputs;
 pub mod simulation;
 pub mod windowed;
 
+// One cargo call that builds gear_rattle with its default features too (`cargo build
+// --workspace`, or `-p gear_rattle -p gearbox_rattle`) unifies them: GearRattle's fmi2*
+// exports would then be linked beside these. Build this crate alone (`-p gearbox_rattle`).
+const _: () = assert!(
+    !gear_rattle::FMU_EXPORTS,
+    "gear_rattle is built with its fmi2* exports (feature `fmu`): build gearbox_rattle in a cargo call of its own"
+);
+
 fmi2_shell::export_co_simulation!(crate::instance::Instance);
 fmi2_shell::export_model_exchange!(crate::instance::Instance);

@@ -4,17 +4,16 @@
 #![allow(non_snake_case, non_upper_case_globals)]
 
 use crate::contract::vr::{self, gear::offset};
+use crate::contract::{DERIVATIVES, STATES};
 use crate::simulation::Simulation;
 use crate::windowed;
-use gear_rattle::gearbox::{self, Gearbox, Readout, State};
-use gear_rattle::integrator::System;
+use gear_rattle::gearbox::{Gearbox, Readout};
 use gear_rattle::rattle::window::Metrics;
 
 /// What the outputs are computed from now.
 struct Now<'a> {
     sim: &'a Simulation,
     gearbox: Gearbox,
-    y: State,
     readout: Readout,
 }
 
@@ -23,9 +22,8 @@ impl<'a> Now<'a> {
         let (gearbox, y) = sim.observed();
         Now {
             sim,
-            gearbox,
-            y,
             readout: gearbox.readout(sim.t, &y),
+            gearbox,
         }
     }
 
@@ -102,19 +100,27 @@ impl Simulation {
             vr::tau_F => -b.T_cl,
             vr::tau_I => now.tau_I(),
             vr::theta_I_out => b.theta_I,
-            vr::omega_I_out | vr::x_omega_I => b.omega_I,
-            vr::alpha_I_out | vr::der_x_omega_I => b.alpha_I,
+            vr::omega_I_out => b.omega_I,
+            vr::alpha_I_out => b.alpha_I,
             vr::phi => b.phi,
-            vr::der_phi => b.phi_dot,
             vr::T_clutch => b.T_cl,
             vr::T_drag => now.T_drag(),
             vr::E_damper => b.e_damper,
             vr::stat_rattle_power => now.box_rattle_power(),
-            _ => {
-                let (i, offset) = vr::gear::locate(vr)?;
-                gear_real(&now, i, offset)?
-            }
+            _ => vr::gear::locate(vr)
+                .and_then(|(i, offset)| gear_real(&now, i, offset))
+                .or_else(|| self.model_exchange_local(vr))?,
         })
+    }
+
+    /// The Model Exchange variables that are not outputs: the state x_omega_I and the
+    /// derivatives (see [`crate::model_exchange`]).
+    fn model_exchange_local(&self, vr: u32) -> Option<f64> {
+        if let Some(k) = STATES.iter().position(|&s| s == vr) {
+            return Some(self.continuous_states()[k]);
+        }
+        let k = DERIVATIVES.iter().position(|&d| d == vr)?;
+        Some(self.derivatives()[k])
     }
 
     /// The value of an Integer output; None if `vr` is none.
@@ -143,15 +149,6 @@ fn gear_real(now: &Now, i: usize, offset: u32) -> Option<f64> {
         impact_speed => g.impacts.last_speed,
         E_contact => g.e_contact,
         E_lubricant => g.e_lubricant,
-        der_xi | der_xi_dot => {
-            let f = now.gearbox.rhs(now.sim.t, &now.y);
-            let k = if offset == der_xi {
-                gearbox::xi(i)
-            } else {
-                gearbox::xi_dot(i)
-            };
-            f[k]
-        }
         stat_rattle_share => {
             let total = now.box_rattle_power();
             if total > 0.0 {

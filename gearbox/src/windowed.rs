@@ -11,6 +11,7 @@ use serde::{Deserialize, Serialize};
 use gear_rattle::gearbox::{self, Gearbox, MAX_GEARS, State, e_contact, e_lubricant, xi};
 use gear_rattle::integrator::{Crossing, Dense, Jacobian, Piecewise, System, Tolerance};
 use gear_rattle::physics::Region;
+use gear_rattle::rattle::refine_peak;
 use gear_rattle::rattle::window::{Quadratures, Window, quadrature};
 
 /// The gearbox's state, then ∫a² dt, ∫F dt, ∫F² dt of each gear slot.
@@ -59,7 +60,8 @@ impl Windowed {
         }
     }
 
-    /// Each gear's |a| at (t, y) for its window's peak.
+    /// Each gear's |a| at (t, y) for its window's peak (Model Exchange: after each of the importer's
+    /// steps).
     pub fn sample_accelerations(&mut self, t: f64, y: &State) {
         let accelerations = self.accelerations(t, y);
         for (window, a) in self.windows.iter_mut().zip(accelerations) {
@@ -145,6 +147,7 @@ impl Piecewise<N> for Windowed {
         };
         if let Some(a) = self.accelerations(t, &h)[i] {
             self.windows[i].acceleration(t, a);
+            self.windows[i].last = Some((t, a));
         }
         let before = self.inner.gears[i].impacts;
         self.inner.cross(at, t, &h);
@@ -157,11 +160,38 @@ impl Piecewise<N> for Windowed {
         }
     }
 
-    /// Each gear's peak |a| sampled at the middle and the end of each accepted step.
+    /// Each gear's largest |a| on an accepted step from t0 of length h, found as GearRattle
+    /// finds its pair's ([`gear_rattle::rattle`]'s `step_peak`): a at the step's ends (the
+    /// start's from the step before, when it ended at t0) and middle and, in contact, where
+    /// the parabola through them peaks inside the step above the window's peak so far, that
+    /// peak located by successive parabolic interpolation on the dense output. In the gap
+    /// the ends alone: the free loose gear's |a| is monotonic there (MODEL.md §3).
     fn observe<D: Dense<N>>(&mut self, t0: f64, h: f64, step: &D) {
-        for theta in [0.5, 1.0] {
+        let a_at = |theta: f64| {
             let y: State = std::array::from_fn(|k| step.dense(k, theta));
-            self.sample_accelerations(t0 + theta * h, &y);
+            self.accelerations(t0 + theta * h, &y)
+                .map(|a| a.unwrap_or(0.0))
+        };
+        let (mid, end) = (a_at(0.5), a_at(1.0));
+        let mut start = None;
+        let mut peaks = [0.0; MAX_GEARS];
+        for (i, peak) in peaks.iter_mut().enumerate().take(self.inner.n_gears()) {
+            let window = &self.windows[i];
+            let a0 = match window.last {
+                Some((t, a)) if t == t0 => a,
+                _ => start.get_or_insert_with(|| a_at(0.0))[i],
+            };
+            *peak = a0.max(end[i]);
+            if self.inner.gears[i].region == Region::Gap {
+                continue;
+            }
+            let points = [(0.0, a0), (0.5, mid[i]), (1.0, end[i])];
+            *peak = refine_peak(points, window.a_peak, |theta| a_at(theta)[i]);
+        }
+        let t = t0 + h;
+        for ((window, peak), end) in self.windows.iter_mut().zip(peaks).zip(end) {
+            window.acceleration(t, peak);
+            window.last = Some((t, end));
         }
     }
 }
