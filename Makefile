@@ -61,9 +61,9 @@ $(LIB): FORCE | libclang
 
 FORCE:
 
-## demo: the paper's bench scenes through fmpy: a summary and plots in target/demo
+## demo: the paper's bench scenes and the gearbox's through fmpy: a summary and plots in target/demo
 demo: fmu $(VENV)/.installed
-	$(PY) scripts/demo.py --fmu $(FMU) --out target/demo
+	$(PY) scripts/demo.py --fmu $(FMU) --out target/demo --box-fmu $(GEARBOX_FMU)
 
 ## test: every test: Rust (cargo test) and the FMU as a user runs it (pytest + fmpy)
 test: $(TEST_TARGETS)

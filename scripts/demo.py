@@ -1,7 +1,7 @@
 """GearRattle demo: the paper's bench scenes run through fmpy, with rattle statistics and
 figures in the style of Dion et al. 2009, Figs. 14-24 (gearrattle.demo).
 
-    .venv/bin/python scripts/demo.py [--fmu PATH] [--out DIR] [--duration S]
+    .venv/bin/python scripts/demo.py [--fmu PATH] [--out DIR] [--duration S] [--box-fmu PATH]
 
 Scenes (MODEL.md section 5): S1 = 30 Hz / 300 rad/s^2 RMS, S2 = 60 Hz / 300, S3 = 30 Hz / 500,
 all in sine mode (excitation = 1) with the paper's parameters (the FMU's start values).
@@ -23,10 +23,13 @@ def main(argv=None):
                     help="output (communication) interval [s]; impacts are read from the "
                          "integer counters, exact while at most one impact per interval")
     ap.add_argument("--scenes", default="S1,S2,S3", help="comma-separated subset of S1,S2,S3")
+    ap.add_argument("--box-fmu", default=None,
+                    help="GearboxRattle.fmu: run the gearbox demo too (idle and run-down at "
+                         "40, -10 and 80 °C, docs/GEARBOX.md)")
     args = ap.parse_args(argv)
     if args.duration <= 0:
         ap.error("--duration must be > 0")
-    return demo.run(args.fmu, args.out, args.duration, args.interval, args.scenes)
+    return demo.run(args.fmu, args.out, args.duration, args.interval, args.scenes, args.box_fmu)
 
 
 if __name__ == "__main__":

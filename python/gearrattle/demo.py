@@ -9,6 +9,7 @@ import time
 
 import numpy as np
 
+from . import gearbox_demo
 from . import rattle_stats as rs
 from .scene_figures import overview_figure, scene_figure
 from .scenes import SCENES, analyse, dist_str, read_params, simulate
@@ -162,10 +163,11 @@ def s1_sound(fmu, out, duration):
     return os.path.join(where, "spectrogram.png")
 
 
-def run(fmu=FMU, out=OUT, duration=1.0, interval=1e-5, scenes="S1,S2,S3"):
+def run(fmu=FMU, out=OUT, duration=1.0, interval=1e-5, scenes="S1,S2,S3", box_fmu=None):
     """Run the scenes named in `scenes` (comma-separated) for `duration` s each with outputs
     every `interval` s, print their statistics and the comparison with the paper, write the
-    figures into `out`; the exit code (1: a scene failed, 2: no FMU)."""
+    figures into `out`; then, with `box_fmu` (GearboxRattle.fmu), the gearbox demo
+    (gearrattle.gearbox_demo). The exit code (1: a scene failed, 2: no FMU)."""
     if not os.path.isfile(fmu):
         print(f"demo: no FMU at {fmu}: build it first", file=sys.stderr)
         return 2
@@ -219,4 +221,19 @@ def run(fmu=FMU, out=OUT, duration=1.0, interval=1e-5, scenes="S1,S2,S3"):
     if failed:
         print(f"FAILED scenes: {', '.join(failed)}")
         return 1
+    if box_fmu is not None:
+        return run_gearbox(box_fmu, out)
+    return 0
+
+
+def run_gearbox(box_fmu, out=OUT):
+    """The gearbox demo and its figures; the exit code (2: no FMU)."""
+    if not os.path.isfile(box_fmu):
+        print(f"demo: no gearbox FMU at {box_fmu}: build it first", file=sys.stderr)
+        return 2
+    os.makedirs(out, exist_ok=True)
+    figures = gearbox_demo.run(box_fmu, out)
+    print("figures:")
+    for f in figures:
+        print("  " + f)
     return 0
