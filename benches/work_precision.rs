@@ -73,7 +73,7 @@ const PEERS_SAME_RHS: [&str; 3] = [
     "differential-equations DOP853",
     "diffsol Tsit45",
 ];
-/// ...and as a user writes them: the RHS literally from MODEL.md, no event handling.
+/// ...and as a user writes them: the RHS literally from docs/MODEL.md, no event handling.
 const PEERS_USER_RHS: [&str; 3] = [
     "differential-equations DOPRI5 (user's RHS)",
     "differential-equations DOP853 (user's RHS)",
@@ -268,7 +268,7 @@ fn run_peer<S: Stepper>(
 }
 
 /// The model a peer integrates: GearRattle's RHS with its event handling (`user` false), or
-/// the RHS as a user writes it from MODEL.md without event handling (`user` true).
+/// the RHS as a user writes it from docs/MODEL.md without event handling (`user` true).
 fn model(sc: &Scene, user: bool) -> Model {
     let p = sc.params();
     let mut m = Model::new(
@@ -481,7 +481,7 @@ struct Config<'a> {
 }
 
 /// The integrators at `rtol`: GearRattle, then each crate with GearRattle's RHS and event
-/// handling, then each crate as a user writes it from MODEL.md.
+/// handling, then each crate as a user writes it from docs/MODEL.md.
 fn integrators(sc: &Scene, rtol: f64) -> Vec<Config<'_>> {
     let mut configs = vec![Config {
         solver: "GearRattle (direct)",
@@ -617,7 +617,7 @@ fn csv_row(suite: &str, sc: &Scene, r: &Reference, m: &Measured) -> String {
         Ok(s) => {
             let e = errors(s, r, sc.window);
             let last = *s.run.counts.last().unwrap_or(&[0, 0]);
-            // Impact rates per flank over [0.2 s, t_end] (MODEL.md §5), for runs past 0.5 s.
+            // Impact rates per flank over [0.2 s, t_end] (docs/MODEL.md §5), for runs past 0.5 s.
             let (rp, rm) = if sc.t_end >= 0.5 {
                 let j = (0.2 / GRID).round() as usize / s.stride;
                 let c = s.run.counts[j];
@@ -753,7 +753,7 @@ fn side_by_side(sc: &Scene, measured: &[Measured]) {
     };
     for (kind, names) in [
         ("GearRattle's RHS and edge handling", PEERS_SAME_RHS),
-        ("user's RHS from MODEL.md", PEERS_USER_RHS),
+        ("user's RHS from docs/MODEL.md", PEERS_USER_RHS),
     ] {
         let best = names
             .iter()
@@ -852,7 +852,7 @@ fn main() {
         let mut sweep = Vec::new();
         for &rtol in &tols {
             // The integrators, side by side: GearRattle, then each crate with GearRattle's RHS
-            // and event handling, then each crate as a user writes it from MODEL.md.
+            // and event handling, then each crate as a user writes it from docs/MODEL.md.
             let configs = integrators(sc, rtol);
             let measured = measure(configs, budget, max_reps);
             report("rust", sc, &reference, &measured, &mut lines);
@@ -961,7 +961,10 @@ fn summary(scenes: &[Scene], ref_dir: &Path, s1: &[Measured]) {
     show("GearRattle (direct)", gr);
     for (kind, names) in [
         ("GearRattle's RHS and edge handling", PEERS_SAME_RHS),
-        ("user's RHS from MODEL.md, no edge handling", PEERS_USER_RHS),
+        (
+            "user's RHS from docs/MODEL.md, no edge handling",
+            PEERS_USER_RHS,
+        ),
     ] {
         let costs: Vec<Option<(f64, bool)>> = names
             .iter()

@@ -1,6 +1,6 @@
-//! `cargo run --release --example gearbox_cost`: the cost of 2 s of GEARBOX.md's default box
+//! `cargo run --release --example gearbox_cost`: the cost of 2 s of docs/GEARBOX.md's default box
 //! (B1, 40 °C) and of the same box at −10 °C (B2), rtol 1e-6 (GearRattle's default), with
-//! each gear's impacts per second over 0.5-2 s and the damper's stage (GEARBOX.md §8's
+//! each gear's impacts per second over 0.5-2 s and the damper's stage (docs/GEARBOX.md §8's
 //! figures to compare with); then the cost of one right-hand side for 1..8 gears, to show
 //! that a box pays for the gears it has, not for the slots. Wall-clock times (the best of
 //! three runs for the box, of five for the right-hand side): on a shared machine, compare
@@ -21,7 +21,7 @@ struct Run {
     max_twist: f64,
 }
 
-/// 2 s of `p` from GEARBOX.md §6's start, sampled every 0.1 ms from 0.5 s.
+/// 2 s of `p` from docs/GEARBOX.md §6's start, sampled every 0.1 ms from 0.5 s.
 fn run(p: &GearboxParams) -> Run {
     let (mut sys, mut y) = Gearbox::start(p, Drive::Engine(Engine::new(&p.engine))).unwrap();
     let mut solver = Solver::new(sys.tolerance(1e-6));

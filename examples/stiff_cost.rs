@@ -1,5 +1,5 @@
 //! `cargo run --release --example stiff_cost [S1|S1-IL|S1-CLM [rtol]]`: the integrator's cost on the
-//! stiff pairs of the stress suite against S1 (MODEL.md §5: 30 Hz, 300 rad/s² RMS, 0.2 s),
+//! stiff pairs of the stress suite against S1 (docs/MODEL.md §5: 30 Hz, 300 rad/s² RMS, 0.2 s),
 //! called directly as the benchmark's "GearRattle (direct)" does (`Solver::advance` to each
 //! 1 ms point, `interpolate_ends`): S1, S1-IL (I_L / 1e4) and S1-CLM (C_LM × 1000), at rtol
 //! 1e-6 and 1e-9, the best wall-clock time of 15 runs (on a shared machine, compare runs of

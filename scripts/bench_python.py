@@ -156,7 +156,7 @@ def run_scipy(p: dict, t_end: float, method: str, rtol: float):
         near += 1
         if near > 500:
             raise RuntimeError(f"chattering: 500 edge crossings within 1 us at t = {t_c:.9f}")
-        if code == 2:  # leaving the gap: an impact (MODEL.md §1)
+        if code == 2:  # leaving the gap: an impact (docs/MODEL.md §1)
             impacts[0 if side < 0 else 1] += 1
         idx += side
         edges += 1

@@ -1,9 +1,9 @@
 """Reference solutions of the work-precision benchmark, from the independent Python
-implementation of MODEL.md (python/gearrattle/reference.py, reused as it is).
+implementation of docs/MODEL.md (python/gearrattle/reference.py, reused as it is).
 
     .venv/bin/python scripts/bench_reference.py [--out target/bench/reference]
 
-For each base scene (S1, S2, S3 of MODEL.md §5 and two stiff variants of S1 from the stress
+For each base scene (S1, S2, S3 of docs/MODEL.md §5 and two stiff variants of S1 from the stress
 suite) it computes, with the paper's parameters, xi(0) = G/2, xi'(0) = 0:
 
 * the reference: reference.simulate at tight tolerance (DOP853 rtol 1e-13 for S1-S3; Radau
@@ -12,7 +12,7 @@ suite) it computes, with the paper's parameters, xi(0) = G/2, xi'(0) = 0:
 * a check by a second method (Radau 1e-12, resp. DOP853 1e-12): the largest |dxi| between the
   two over the error window is the floor below which errors cannot be told apart;
 * the predictable window: the run is repeated from xi(0) = G/2 + 1e-4 G and the window ends
-  where the two differ by 1e-2 G (MODEL.md §5's criterion); the whole run when they never do.
+  where the two differ by 1e-2 G (docs/MODEL.md §5's criterion); the whole run when they never do.
 
 Writes <out>/scenes.csv (one row per benchmark scene) and <out>/<base>.csv (t, xi, xi_dot,
 n_plus, n_minus on the grid). Takes about 6 minutes (the Radau checks); `make bench` reruns it

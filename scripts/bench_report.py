@@ -39,7 +39,7 @@ STEPS = "GearRattle Simulation::step_to (no FMI)"
 FMPY = "GearRattle FMU (fmpy)"
 # Two kinds of Rust peer (benches/work_precision/peers.rs): the crates on GearRattle's RHS with
 # GearRattle's edge handling (an integrator comparison), and the crates as users write them
-# from MODEL.md (their own literal RHS, region from xi at each call, no edge handling).
+# from docs/MODEL.md (their own literal RHS, region from xi at each call, no edge handling).
 SAME_RHS = ["differential-equations DOPRI5", "differential-equations DOP853", "diffsol Tsit45"]
 USER_RHS = [f"{n} (user's RHS)" for n in SAME_RHS]  # no comma: the CSV is not quoted
 RUST_PEERS = SAME_RHS + USER_RHS
@@ -245,7 +245,7 @@ def parse_profile(text):
     for m in re.finditer(r"^  (.+?)\s{2,}(\d+) RHS \(\s*([0-9.]+) %\)\s+([0-9.]+) ns each\s+([0-9.]+) % of the CPU", text, re.M):
         p["regions"][m.group(1).strip()] = dict(count=int(m.group(2)), pct=float(m.group(3)), ns=float(m.group(4)),
                                                 cpu=float(m.group(5)))
-    m = re.search(r"literal MODEL.md RHS .*?: ([0-9./ ]+) ns per region; the run's RHS\s+would cost ([0-9.]+) %", text, re.S)
+    m = re.search(r"literal docs/MODEL.md RHS .*?: ([0-9./ ]+) ns per region; the run's RHS\s+would cost ([0-9.]+) %", text, re.S)
     if m:
         p["literal_ns"], p["literal_pct"] = m.group(1).strip(), float(m.group(2))
     m = re.search(r"right-hand sides ([0-9.]+) % of the CPU time; the rest \(([0-9.]+) %, ([0-9.]+) ns per RHS\)", text)
@@ -279,7 +279,7 @@ def analysis(rows, s1, r_rust, n_rust, r_user, n_user, r_py, n_py, comm_rows, to
         uc, _, uh = s1[n_user]
         met = "met" if r_user >= 3 else "not met"
         a(f"**Against the Rust crates as users write them ({r_user:.2f}× at 1e-9 m on S1, target 3×: {met}).** "
-          "Each crate on the right-hand side written literally from MODEL.md (powf for |δ/G|^(α−1), the band's "
+          "Each crate on the right-hand side written literally from docs/MODEL.md (powf for |δ/G|^(α−1), the band's "
           "sine as written, the excitation's sin and cos, the region from ξ at each call), with its own stepping "
           "and no edge handling: steps straddle the kinks of the contact law. Fastest at 1e-9 m: "
           f"{n_user}, {fmt_t(uc)}" + (f" and {uh:.3g} RHS ({uh / gr_h:.2f}× GearRattle's)" if uh else "") +
@@ -335,7 +335,7 @@ def analysis(rows, s1, r_rust, n_rust, r_user, n_user, r_py, n_py, comm_rows, to
                   "; ".join(re.sub(r"\s+", " ", ln.strip()).replace(" [.] ", " ") for ln in perf_lines[:8]) + ".")
                 a("")
             if "literal_pct" in p:
-                a(f"The RHS of the user's-RHS peers (peers::UserRhs, literally from MODEL.md) costs "
+                a(f"The RHS of the user's-RHS peers (peers::UserRhs, literally from docs/MODEL.md) costs "
                   f"{p['literal_ns']} ns per region (contact F+ / band F+ / gap / band F− / contact F−) in the same "
                   f"loop, i.e. {p['literal_pct']:.0f} % of GearRattle's RHS time over this run's evaluations: "
                   "GearRattle's RHS is " + ("cheaper" if p["literal_pct"] > 100 else "not cheaper") +
@@ -604,7 +604,7 @@ def main() -> None:
 
     w(crate_target("the crates on GearRattle's RHS and edge handling (integrators compared)",
                    q_rust, n_q_rust, q_rust_s, n_q_rust_s, r_rust, t_rust, n_rust, t_rust_s, n_rust_s))
-    w(crate_target("the crates as users write them (RHS from MODEL.md, no edge handling)",
+    w(crate_target("the crates as users write them (RHS from docs/MODEL.md, no edge handling)",
                    q_user, n_q_user, q_user_s, n_q_user_s, r_user, t_user, n_user, t_user_s, n_user_s))
     r_py_v = r_py if r_py is not None else r_py_s
     w(f"| GearRattle ≥ 150× faster than the fastest scipy method at 1e-9 m on S1 | S1 1 s: {t_py} "
@@ -662,7 +662,7 @@ def main() -> None:
     # ---- method
     w("## What is measured")
     w("")
-    w("- Scenes (MODEL.md §5, paper parameters, ξ(0) = G/2, ξ'(0) = 0): S1 30 Hz / 300 rad/s² RMS, "
+    w("- Scenes (docs/MODEL.md §5, paper parameters, ξ(0) = G/2, ξ'(0) = 0): S1 30 Hz / 300 rad/s² RMS, "
       "S2 60 Hz / 300, S3 30 Hz / 500, each over 0.2 s and 1 s; and two stiff variants of S1 from the stress suite "
       "over 0.2 s: S1-IL (I_L = 0.32e-7 kg m², 1e4 times lighter) and S1-CLM (C_LM × 1000).")
     w("- Error: max |Δξ| on a 1 ms grid over the predictable window, against an independent reference "
@@ -670,7 +670,7 @@ def main() -> None:
       "checked by a second method; RMS of the pitch-line speed error (Δξ', as r_L ω_L = ξ' + r_M ω_M) in the CSV. "
       "The FMU at 10 ms is compared on its 10 ms points.")
     w("- Predictable window: the reference rerun from ξ(0) + 1e-4·G; the window ends where the two differ by "
-      "1e-2·G (MODEL.md §5). Beyond it (S2 1 s) the impact rates per flank over 0.2-1 s are compared instead.")
+      "1e-2·G (docs/MODEL.md §5). Beyond it (S2 1 s) the impact rates per flank over 0.2-1 s are compared instead.")
     w("- Cost: CPU time of the calling thread (Rust: CLOCK_THREAD_CPUTIME_ID; Python: process_time), median of "
       "interleaved repeats (Rust: 3-9 within a 1.5 s budget per group, and on S1 the side-by-side group at equal "
       "error, suite rust-equal-error of rust.csv: up to 41 within 4 s; Python: 3 when a run is under 2 s, else 1); "
@@ -696,7 +696,7 @@ def main() -> None:
       "stepped through OrdinaryNumericalMethod (its DOPRI5 evaluates f(y1) again after each accepted step: 7 RHS "
       "per step; DOP853 12 + 3 for its dense output; each restart costs one RHS in `init`); diffsol's ERK (Tsit45, "
       "nalgebra vectors) through OdeSolverMethod::step, set_stop_time and state_mut. "
-      "\"User's RHS\": the same three crates as a user writes them from MODEL.md: one right-hand side written "
+      "\"User's RHS\": the same three crates as a user writes them from docs/MODEL.md: one right-hand side written "
       "literally (peers::UserRhs: powf for |δ/G|^(α−1), the band's sine as in §2, sin and cos of the "
       "excitation, region from ξ at each call), shared by the three, and no event handling (steps straddle the "
       "contact law's kinks); the same error weights, steps ending on the 1 ms grid points.")

@@ -3,7 +3,7 @@ figures in the style of Dion et al. 2009, Figs. 14-24 (gearrattle.demo).
 
     .venv/bin/python scripts/demo.py [--fmu PATH] [--out DIR] [--duration S] [--box-fmu PATH]
 
-Scenes (MODEL.md section 5): S1 = 30 Hz / 300 rad/s^2 RMS, S2 = 60 Hz / 300, S3 = 30 Hz / 500,
+Scenes (docs/MODEL.md section 5): S1 = 30 Hz / 300 rad/s^2 RMS, S2 = 60 Hz / 300, S3 = 30 Hz / 500,
 all in sine mode (excitation = 1) with the paper's parameters (the FMU's start values).
 Statistics are taken from 0.2 s (start-up transient left out) to the end of the run.
 """

@@ -1,4 +1,4 @@
-"""Check the gearbox reference (gearrattle.gearbox_reference) against GEARBOX.md §8.
+"""Check the gearbox reference (gearrattle.gearbox_reference) against docs/GEARBOX.md §8.
 
 Slow (minutes on a 2-core machine), not part of the test suite:
 

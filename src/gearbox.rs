@@ -1,9 +1,9 @@
-//! The gearbox in neutral (GEARBOX.md): N ≤ 8 loose gears rattling against driving gears on
+//! The gearbox in neutral (docs/GEARBOX.md): N ≤ 8 loose gears rattling against driving gears on
 //! the input side, behind the two-stage clutch damper, driven by the flywheel. A
 //! piecewise-smooth ODE for the integrator, built from the gear pair's physics (one
 //! [`Dynamics`] and contact law per gear) with the damper's stages as one more guard.
 //!
-//! Relative coordinates (GEARBOX.md §3): the damper's twist φ = θ_F − θ_I and its rate
+//! Relative coordinates (docs/GEARBOX.md §3): the damper's twist φ = θ_F − θ_I and its rate
 //! φ' = ω_F − ω_I, and each gear's transmission error ξ_i = r_L,i θ_L,i − r_M,i ρ_i θ_I with
 //! ξ_i'. The flywheel's motion is known (the engine's closed form, or the drivetrain's inputs
 //! extrapolated over a step), so ω_I = ω_F − φ'. With ω_I' = α_I:
@@ -51,7 +51,7 @@ pub const fn omega_F(n: usize) -> usize {
 /// The quadratures, outside the error control, after the slots of [`MAX_GEARS`] gears and
 /// one for ω_F: θ_F under a ramp; the energy the damper dissipates, the input side's drag
 /// dissipates, the flywheel feeds in (∫ T_cl ω_F dt); then each gear's contact and
-/// lubricant energies (MODEL.md §3).
+/// lubricant energies (docs/MODEL.md §3).
 pub const THETA_F: usize = 3 + 2 * MAX_GEARS;
 pub const E_DAMPER: usize = THETA_F + 1;
 pub const E_INPUT_DRAG: usize = THETA_F + 2;
@@ -69,7 +69,7 @@ pub type State = [f64; N];
 /// What drives the box.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub enum Drive {
-    /// The flywheel driven by the built-in engine (GEARBOX.md §4).
+    /// The flywheel driven by the built-in engine (docs/GEARBOX.md §4).
     Engine(Engine),
     /// The flywheel's θ_F, ω_F, α_F from the drivetrain at a communication point,
     /// extrapolated over the step.
@@ -157,7 +157,7 @@ impl Gearbox {
         }
     }
 
-    /// GEARBOX.md §6's start for `params`, once validated: φ = 0, the input side at the
+    /// docs/GEARBOX.md §6's start for `params`, once validated: φ = 0, the input side at the
     /// flywheel's speed, every loose gear at rigid meshing speed (ξ_i' = 0) mid-backlash;
     /// under an engine ramp ω_F(0) (and θ_F = 0) as states.
     pub fn start(params: &GearboxParams, drive: Drive) -> Result<(Self, State), GearboxParamError> {
@@ -271,7 +271,7 @@ impl Gearbox {
         }
     }
 
-    /// The loads at (t, y) with the current stage and regions (GEARBOX.md §2, §3): the
+    /// The loads at (t, y) with the current stage and regions (docs/GEARBOX.md §2, §3): the
     /// contact forces first, which with the damper give α_I, which drives every ξ_i''.
     #[inline]
     pub fn loads(&self, t: f64, y: &State) -> Loads {
@@ -322,7 +322,7 @@ impl Gearbox {
 }
 
 impl System<N> for Gearbox {
-    /// GEARBOX.md §3 in relative coordinates, with the quadratures of the energy balance.
+    /// docs/GEARBOX.md §3 in relative coordinates, with the quadratures of the energy balance.
     #[inline]
     fn rhs(&self, t: f64, y: &State) -> State {
         self.rhs_with(&self.loads(t, y), y)

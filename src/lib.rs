@@ -3,13 +3,13 @@
 //!
 //! Layers, each knowing nothing of the ones above it:
 //! - [`math`]: cheap elementary functions for the right-hand side (cube root, sine);
-//! - [`physics`]: contact law, equation of motion, excitation (MODEL.md), and the main
+//! - [`physics`]: contact law, equation of motion, excitation (docs/MODEL.md), and the main
 //!   shaft's inertia for the torque mode;
 //! - [`integrator`]: adaptive DOPRI5, Taylor-series steps and Radau IIA with error control,
 //!   dense outputs, the hand-over between them, and edge location;
 //! - [`rattle`]: the gear pair as a piecewise ODE for the integrator, with impact counting
 //!   (the shaft's motion imposed; [`rattle::torque`]: driven by a torque, 7 states);
-//! - [`gearbox`]: the gearbox of GEARBOX.md (up to 8 loose gears behind a clutch damper) as
+//! - [`gearbox`]: the gearbox of docs/GEARBOX.md (up to 8 loose gears behind a clutch damper) as
 //!   a piecewise ODE with one guard per gear and one for the damper;
 //! - [`instance`]: the slave of fmi2-shell (variables, co-simulation stepping, Model
 //!   Exchange's states and events; the shell applies FMI's rules around it);

@@ -230,7 +230,7 @@ const SIN_SQUARED: [f64; 13] = {
     c
 };
 
-/// sin² x for |x| ≤ π/2: the smoothing factor of the contact bands (MODEL.md §2), to
+/// sin² x for |x| ≤ π/2: the smoothing factor of the contact bands (docs/MODEL.md §2), to
 /// 6e-16 absolute, under 3 ulp of 1 (test `sin_squared_matches_std`, measured 5.6e-16).
 /// x² times the Taylor series of (sin x / x)² to u^12 (u = x², truncation below 2e-16 at
 /// π/2), summed by Estrin's scheme.

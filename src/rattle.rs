@@ -1,6 +1,6 @@
 //! The rattling gear as a piecewise-smooth ODE for the integrator: the state layout, the
-//! right-hand side (MODEL.md §3 plus the dissipated energies and the shaft's work as
-//! quadratures), the region as the current piece, and the impact counters (MODEL.md §1: an
+//! right-hand side (docs/MODEL.md §3 plus the dissipated energies and the shaft's work as
+//! quadratures), the region as the current piece, and the impact counters (docs/MODEL.md §1: an
 //! impact is ξ leaving the gap, across 0 downwards on F+ or G upwards on F−). [`torque`] is
 //! the same gear pair with the main shaft an inertia driven by a torque (torque mode);
 //! [`window`] the rattle statistics over a window of time. A pair carries the window's
@@ -147,7 +147,7 @@ pub(crate) fn scales(p: &GearParams) -> (f64, f64) {
 }
 
 /// The region entered through `edge` at ξ' = xi_dot, and the flank (0: F+, 1: F−) of the
-/// onset counted in `impacts` when it leaves the gap (MODEL.md §1).
+/// onset counted in `impacts` when it leaves the gap (docs/MODEL.md §1).
 pub(crate) fn enter_region(
     law: &ContactLaw,
     region: Region,
@@ -210,7 +210,7 @@ impl<const N: usize> KinematicRattle<N> {
     }
 }
 
-/// The rates of the quadratures of [`window::quadrature`]: MODEL.md §3's energy balance (the
+/// The rates of the quadratures of [`window::quadrature`]: docs/MODEL.md §3's energy balance (the
 /// power lost in the contact damping F_c ξ', in the lubricant C (ω_L − ω_S)², the power
 /// −τ_M ω_M the main shaft feeds in), then a², F and F² with a = r_L α_L.
 #[inline]
@@ -239,7 +239,7 @@ pub(crate) fn quadrature_rates(
 /// peak so far, that peak located by successive parabolic interpolation on the dense output.
 /// In the gap the ends (or the window's opening) alone: the loose gear is free there,
 /// I_L ω_L' = B − C (ω_L − ω_S) moves ω_L monotonically and a = (r_L / I_L)(B − C (ω_L − ω_S))
-/// with it (MODEL.md §3), so |a| peaks at an end. Points outside the current piece (past an
+/// with it (docs/MODEL.md §3), so |a| peaks at an end. Points outside the current piece (past an
 /// edge the step is redone to end on) are not the piece's and are left out.
 pub(crate) fn step_peak<S: GearPair<N>, D: Dense<N>, const N: usize>(
     sys: &S,
@@ -328,7 +328,7 @@ fn parabola_peak(p: &[(f64, f64); 3]) -> Option<(f64, f64)> {
 }
 
 impl<const N: usize> Jacobian<N> for KinematicRattle<N> {
-    /// ∂f/∂y of `rhs` for Radau IIA: the contact's slopes (MODEL.md §2) through the equation of
+    /// ∂f/∂y of `rhs` for Radau IIA: the contact's slopes (docs/MODEL.md §2) through the equation of
     /// motion (§3), ∂ξ''/∂ξ = −(r_L²/I_L) ∂F/∂ξ and ∂ξ''/∂ξ' = −(r_L²/I_L) ∂F/∂ξ' − C/I_L. The
     /// rows of the quadratures (energies, work) are left zero: they do not act back on ξ, ξ',
     /// so Radau's simplified Newton iteration gives them their exact stage values from those

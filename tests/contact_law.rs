@@ -1,4 +1,4 @@
-//! The contact law against MODEL.md §2: values at chosen points, continuity of F and dF/dξ
+//! The contact law against docs/MODEL.md §2: values at chosen points, continuity of F and dF/dξ
 //! across each band edge, and the identities between the paper's constants (§4).
 #![allow(non_snake_case)]
 
@@ -45,7 +45,7 @@ fn values_at_chosen_points_match_model_md() {
             let got = force(&law, xi, xi_dot);
             assert!(
                 (got - expected).abs() <= 1e-12 * expected.abs().max(1e-9),
-                "xi = {xi:e}, xi' = {xi_dot}: {got} vs MODEL.md {expected}"
+                "xi = {xi:e}, xi' = {xi_dot}: {got} vs docs/MODEL.md {expected}"
             );
         }
     }
@@ -101,7 +101,7 @@ fn without_a_band_the_force_is_continuous_at_the_gap_edges() {
 }
 
 /// K* δ |δ/G|^(α−1) = K_LM δ |δ|^(α−1) with K_LM = K*/G^(α−1), and the paper's numbers:
-/// K_LM = 1.03e8 N/m^(4/3), C*_LM = 0.04, C* = 78 1/s (MODEL.md §4).
+/// K_LM = 1.03e8 N/m^(4/3), C*_LM = 0.04, C* = 78 1/s (docs/MODEL.md §4).
 #[test]
 fn paper_constants_and_the_k_lm_identity() {
     let p = GearParams::paper();

@@ -262,7 +262,7 @@ fn moves(sim: &mut Simulation, v: &Variable, known: u32) -> bool {
     before != after
 }
 
-/// Each parameter's range as MODEL.md §4 and §5 give it, written out here: the contract's
+/// Each parameter's range as docs/MODEL.md §4 and §5 give it, written out here: the contract's
 /// ranges must refuse a value just outside and admit the bound itself where it is inclusive.
 const RANGES: [(&str, f64, Option<f64>, &str); 12] = [
     // (name, a value outside, the inclusive bound or None, the range the message states)

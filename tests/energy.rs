@@ -1,6 +1,6 @@
-//! Energy balance of MODEL.md §3 with C = C_LM = 0 (and B = 0): ½ I_L ω_L² + V(ξ) minus the
+//! Energy balance of docs/MODEL.md §3 with C = C_LM = 0 (and B = 0): ½ I_L ω_L² + V(ξ) minus the
 //! work fed in by the main shaft stays constant (in torque mode, with the shaft's kinetic
-//! energy, minus the work of the drivetrain's torque). V is integrated here from MODEL.md's
+//! energy, minus the work of the drivetrain's torque). V is integrated here from docs/MODEL.md's
 //! contact law (tests/common), independently of the crate.
 #![allow(non_snake_case)]
 
@@ -11,7 +11,7 @@ use gear_rattle::integrator::Solver;
 use gear_rattle::physics::{Dynamics, Excitation, GearParams, Sine};
 use gear_rattle::rattle::{self, KinematicRattle, W_SHAFT, XI, XI_DOT};
 
-/// The paper's gear pair without its dampings, for the crate and for MODEL.md written out.
+/// The paper's gear pair without its dampings, for the crate and for docs/MODEL.md written out.
 fn lossless() -> (GearParams, Paper) {
     let params = GearParams {
         C_LM: 0.0,

@@ -101,7 +101,7 @@ fn scene_s1_runs_through_the_c_api() {
     inst.get_integer(&[vr::impacts_Fplus, vr::impacts_Fminus], &mut counts)
         .ok()
         .unwrap();
-    // 0.2 s of S1: the first runs of MODEL.md's pattern (4, then 5 per flank) on both flanks,
+    // 0.2 s of S1: the first runs of docs/MODEL.md's pattern (4, then 5 per flank) on both flanks,
     // and ξ goes into both flanks by micrometres only.
     assert!(counts[0] >= 9 && counts[1] >= 5, "impacts {counts:?}");
     assert!(min_xi < 0.0 && min_xi > -0.5 * g, "min xi {min_xi:e}");

@@ -1,5 +1,5 @@
-//! The gearbox of GEARBOX.md against what can be known without it: the energy balance of §3
-//! with every dissipation off (the potentials written out here, V_i from MODEL.md's contact
+//! The gearbox of docs/GEARBOX.md against what can be known without it: the energy balance of §3
+//! with every dissipation off (the potentials written out here, V_i from docs/MODEL.md's contact
 //! law in tests/common), the damper's linear resonance, the right-hand side for one gear
 //! against GearRattle's gear pair, and §8's regimes (every gear rattles at 40 °C, none at
 //! −10 °C).
@@ -50,7 +50,7 @@ fn run(
     solver
 }
 
-/// GEARBOX.md §2's V_cl = ∫ T_k dφ, written out.
+/// docs/GEARBOX.md §2's V_cl = ∫ T_k dφ, written out.
 fn V_cl(p: &GearboxParams, phi: f64) -> f64 {
     let (k_1, k_2, phi_1) = (p.damper.k_1, p.damper.k_2, p.damper.phi_1);
     let a = phi.abs();
@@ -61,7 +61,7 @@ fn V_cl(p: &GearboxParams, phi: f64) -> f64 {
     }
 }
 
-/// GEARBOX.md §3: with c_cl = H_1 = H_2 = 0, c_I = C_i = C_LM,i = B_i = 0,
+/// docs/GEARBOX.md §3: with c_cl = H_1 = H_2 = 0, c_I = C_i = C_LM,i = B_i = 0,
 /// ½ I_I ω_I² + Σ ½ I_L,i ω_L,i² + V_cl(φ) + Σ V_i(ξ_i) − ∫ T_cl ω_F dt stays constant over
 /// 1 s of the default box, within 1e-9 of its kinetic energy.
 #[test]
@@ -153,7 +153,7 @@ fn the_damper_resonates_at_its_linear_frequency() {
 
 /// One gear with ρ = 1.5, driven by inputs: its ξ'' equals GearRattle's for the same ξ, ξ'
 /// with the main shaft turning as the driving gear (r_M ρ, ω_I = ω_F − φ', α_I from
-/// GEARBOX.md §3 written out here), in every region; and φ'' = α_F − α_I.
+/// docs/GEARBOX.md §3 written out here), in every region; and φ'' = α_F − α_I.
 #[test]
 fn one_gear_follows_the_gear_pairs_right_hand_side() {
     let mut p = GearboxParams::default_box();
@@ -170,7 +170,7 @@ fn one_gear_follows_the_gear_pairs_right_hand_side() {
         (y[PHI], y[PHI_DOT], y[xi(0)], y[xi_dot(0)]) = (phi, phi_dot, xi0, xi_dot0);
         let sys = Gearbox::new(&p, inputs, &y);
         let f = sys.rhs(0.01, &y);
-        // GEARBOX.md §2-§3 by hand (pre-damper, drags at 40 °C).
+        // docs/GEARBOX.md §2-§3 by hand (pre-damper, drags at 40 °C).
         let omega_I = flywheel.omega - phi_dot;
         let d = &p.damper;
         let T_cl = d.k_1 * phi + d.H_1 * (phi_dot / d.omega_h).tanh() + d.c_cl * phi_dot;
@@ -237,7 +237,7 @@ fn rattle_rates(T_oil: f64, from: f64, to: f64) -> (Vec<f64>, f64, Solver<{ gear
     (rates, main as f64 / samples as f64, solver)
 }
 
-/// GEARBOX.md §8, B1: the default box at 40 °C runs 1 s and every gear rattles (§8's
+/// docs/GEARBOX.md §8, B1: the default box at 40 °C runs 1 s and every gear rattles (§8's
 /// reference: ≈ 140 / 220 / 185 / 165 / 185 impacts per second over 0.5-2 s).
 #[test]
 fn every_gear_rattles_at_40_degrees() {
@@ -250,7 +250,7 @@ fn every_gear_rattles_at_40_degrees() {
     assert!(rates.iter().all(|&r| r > 20.0), "{rates:?}");
 }
 
-/// GEARBOX.md §8, B2: at −10 °C the cold drag holds every gear on its flank: no impact.
+/// docs/GEARBOX.md §8, B2: at −10 °C the cold drag holds every gear on its flank: no impact.
 #[test]
 fn no_gear_rattles_at_minus_10_degrees() {
     let (rates, main, _) = rattle_rates(-10.0, 0.5, 1.0);

@@ -2,7 +2,7 @@
 //! gear-rattle equations.
 //!
 //! Every peer integrates the same piecewise ODE as GearRattle: the right-hand side is the one
-//! of `gear_rattle::rattle::Rattle` (MODEL.md §2-3 with the region's formula locked; the same
+//! of `gear_rattle::rattle::Rattle` (docs/MODEL.md §2-3 with the region's formula locked; the same
 //! function, so one evaluation costs the same for every solver and the ratios measure the
 //! integration), and the same event handling as GearRattle's solver: after each accepted step
 //! the driver below checks whether ξ left the current region [lo, hi], at the step's end or
@@ -20,7 +20,7 @@
 //! crates' event APIs (differential-equations' `Event`, diffsol's root functions) watch sign
 //! changes at step ends only and would skip a grazing contact; they are not used.
 //!
-//! The second kind of peer is the crate as a user would use it after reading MODEL.md: the
+//! The second kind of peer is the crate as a user would use it after reading docs/MODEL.md: the
 //! right-hand side written literally from it ([`UserRhs`]: powf for |δ/G|^(α−1), the band's
 //! sine as written in §2, the excitation's sin and cos, the region found from ξ at each call),
 //! one function shared by every crate, and no event handling: the crate's own stepping only,
@@ -34,7 +34,7 @@ use gear_rattle::integrator::{Crossing, Edge, Piecewise, roots};
 use gear_rattle::physics::{Dynamics, Excitation, GearParams, Region};
 use gear_rattle::rattle::{N, Rattle, State, XI, XI_DOT};
 
-/// MODEL.md §2, §3 and §5 written out literally: the right-hand side a user of a general ODE
+/// docs/MODEL.md §2, §3 and §5 written out literally: the right-hand side a user of a general ODE
 /// crate writes for the state [ξ, ξ', E_contact, E_lubricant, W_shaft], with the region taken
 /// from ξ at each call (nothing of GearRattle's code: its own powf, sin, sin and cos).
 #[derive(Clone, Copy, Debug)]

@@ -152,7 +152,7 @@ pub fn run(scenes: &[Scene]) {
         ns[i] = ns_per_rhs(|t, y| r.rhs(t, y), states[i]);
     }
     let rhs_time: f64 = (0..5).map(|i| evals[i] as f64 * ns[i] * 1e-9).sum();
-    // The same right-hand side written literally from MODEL.md, as a peer's user would write
+    // The same right-hand side written literally from docs/MODEL.md, as a peer's user would write
     // it (powf for |δ/G|^(α−1), the band's sine as written, sin and cos of the excitation).
     let user = peers::UserRhs::new(p, sc.A_rms, sc.f_exc);
     let ns_literal: [f64; 5] =
@@ -197,7 +197,7 @@ pub fn run(scenes: &[Scene]) {
         );
     }
     println!(
-        "literal MODEL.md RHS (powf, the band's sine as written): {} ns per region; the run's RHS \
+        "literal docs/MODEL.md RHS (powf, the band's sine as written): {} ns per region; the run's RHS \
          would cost {:.0} % of GearRattle's RHS time",
         ns_literal
             .iter()

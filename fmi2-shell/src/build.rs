@@ -847,7 +847,7 @@ fn apple_link_args() {
 #[cfg(test)]
 mod tests {
     //! The generator on the contracts of the repository: GearboxRattle's arrays expand to the
-    //! names, value references and dependencies GEARBOX.md's FMU needs, its Rust constants
+    //! names, value references and dependencies docs/GEARBOX.md's FMU needs, its Rust constants
     //! compile and behave, and both model descriptions pass fmpy's validation.
 
     use super::*;

@@ -196,7 +196,7 @@ impl Slave for Instance {
         self.sim = None;
     }
 
-    /// Checks every parameter (the contract's ranges, then GEARBOX.md's rules between them:
+    /// Checks every parameter (the contract's ranges, then docs/GEARBOX.md's rules between them:
     /// k_2 ≥ k_1, ν_100 < ν_40, ...) and builds the start; an invalid parameter is refused
     /// and the instance stays in initialisation mode, where it can be corrected.
     fn exit_initialization_mode(&mut self) -> FmiResult {

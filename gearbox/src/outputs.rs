@@ -1,5 +1,5 @@
 //! Every output (and local) of the contract, computed from the running gearbox when it is
-//! read (GEARBOX.md §7): the box's, then gear i's by its offset in the gear's block. The
+//! read (docs/GEARBOX.md §7): the box's, then gear i's by its offset in the gear's block. The
 //! slots of gears beyond n_gears read 0.
 #![allow(non_snake_case, non_upper_case_globals)]
 

@@ -1,5 +1,5 @@
 //! The running gearbox of an initialised instance: its parameters from the contract's
-//! values, what drives it (GEARBOX.md §4 or the drivetrain's inputs), the solver and the
+//! values, what drives it (docs/GEARBOX.md §4 or the drivetrain's inputs), the solver and the
 //! state, the clock, and the statistics window that opens on the way ([`crate::windowed`]).
 #![allow(non_snake_case)]
 
@@ -151,8 +151,8 @@ macro_rules! on_run {
 }
 
 impl Simulation {
-    /// Checks the parameters (the contract's ranges, then GEARBOX.md's rules between them)
-    /// and builds GEARBOX.md §6's start at t0 with φ(0) = phi_start and each
+    /// Checks the parameters (the contract's ranges, then docs/GEARBOX.md's rules between them)
+    /// and builds docs/GEARBOX.md §6's start at t0 with φ(0) = phi_start and each
     /// ξ_i(0) = gap_start_i G_i, the output shaft at omega_out.
     pub fn new(values: &Values, t0: f64, rtol: f64, model_exchange: bool) -> FmiResult<Self> {
         contract::check_parameters(values)?;

@@ -1,5 +1,5 @@
 //! The gearbox with the rattle statistics of each gear over the window [stats_from, t]
-//! (GEARBOX.md §7, docs/METRICS.md): the [`Window`] of GearRattle per gear, counting the
+//! (docs/GEARBOX.md §7, docs/METRICS.md): the [`Window`] of GearRattle per gear, counting the
 //! impacts, runs and contact time as the integrator crosses the band edges, and the
 //! quadratures ∫a² dt, ∫F dt, ∫F² dt of each gear carried after the gearbox's state. A run
 //! steps the plain [`Gearbox`] until the window opens and this one from then on, so that the
@@ -165,7 +165,7 @@ impl Piecewise<N> for Windowed {
     /// start's from the step before, when it ended at t0) and middle and, in contact, where
     /// the parabola through them peaks inside the step above the window's peak so far, that
     /// peak located by successive parabolic interpolation on the dense output. In the gap
-    /// the ends alone: the free loose gear's |a| is monotonic there (MODEL.md §3).
+    /// the ends alone: the free loose gear's |a| is monotonic there (docs/MODEL.md §3).
     fn observe<D: Dense<N>>(&mut self, t0: f64, h: f64, step: &D) {
         let a_at = |theta: f64| {
             let y: State = std::array::from_fn(|k| step.dense(k, theta));

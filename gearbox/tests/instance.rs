@@ -49,7 +49,7 @@ fn integer(i: &mut Fmu<Instance>, vr: u32) -> i32 {
     out[0]
 }
 
-/// GEARBOX.md's rules between parameters (k_2 ≥ k_1, ν_100 < ν_40) are refused at
+/// docs/GEARBOX.md's rules between parameters (k_2 ≥ k_1, ν_100 < ν_40) are refused at
 /// fmi2ExitInitializationMode with the parameter's name; the instance stays in
 /// initialisation mode, where the value can be corrected.
 #[test]

@@ -1,4 +1,4 @@
-//! `documentation/index.html` inside GearRattle's FMU: the equations of MODEL.md with the
+//! `documentation/index.html` inside GearRattle's FMU: the equations of docs/MODEL.md with the
 //! paper's numbers, and the parameter and variable tables generated from the contract.
 
 use crate::contracts::gear_rattle::{Causality, VARIABLES, Variable};

@@ -316,7 +316,7 @@ def report(rows, labels, hs, t_end, ref_check, wall, command, out_md: pathlib.Pa
         "of the loose gear can put one impact a step earlier or later, after which ξ differs",
         "by a fraction of G and ω_M by a few",
         "0.01 rad/s whatever the step (the rattle is pointwise predictable only for a while, as",
-        "MODEL.md notes for the bench scene S2); the impact rate over the whole run stays",
+        "docs/MODEL.md notes for the bench scene S2); the impact rate over the whole run stays",
         "comparable.",
         "",
         "## Results",

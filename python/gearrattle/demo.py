@@ -105,7 +105,7 @@ def verdicts(results):
                    f"acceleration {s1['rms_a']:.1f} -> {s3['rms_a']:.1f} m/s^2: "
                    + ("stronger impacts, as in the paper" if v3 > v1 and s3["rms_a"] > s1["rms_a"]
                       else "NOT stronger, unlike the paper"))
-    out.append("Not checked here, known from MODEL.md: with the paper's parameters the model "
+    out.append("Not checked here, known from docs/MODEL.md: with the paper's parameters the model "
                "rattles from ~3.3 rad/s^2 RMS at 30 Hz, far below the levels the paper tested "
                "(the bench showed no impact at low levels); the model's backlash is 25 um "
                "where the bench's measured gap suggests ~80 um.")

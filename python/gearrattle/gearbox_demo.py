@@ -1,4 +1,4 @@
-"""The gearbox demo (GEARBOX.md): the default five-speed box in neutral at idle and on a
+"""The gearbox demo (docs/GEARBOX.md): the default five-speed box in neutral at idle and on a
 run-down from 1000 to 600 rpm, with the oil at 40 °C, −10 °C and 80 °C, run through fmpy.
 Prints per gear its impacts per second per flank, runs, mean impact speed, rattle power and
 share, and the damper's main-stage share and mean drag; draws per temperature the gears' xi
@@ -25,7 +25,7 @@ FLANKS = ("Fplus", "Fminus")
 
 
 def _start(md) -> dict:
-    """The contract's start values the demo reads (GEARBOX.md §6's defaults)."""
+    """The contract's start values the demo reads (docs/GEARBOX.md §6's defaults)."""
     starts = {v.name: v.start for v in md.modelVariables if v.causality == "parameter"}
     n = int(starts["n_gears"])
     return dict(n=n, G=[float(starts[f"gear[{i}].G"]) for i in range(1, n + 1)], phi_1=float(starts["phi_1"]))
@@ -127,7 +127,7 @@ def run(fmu=GF.GEARBOX_FMU, out="target/demo"):
 
     md = read_model_description(str(fmu))
     box = _start(md)
-    print(f"\nGearbox demo: {fmu}, {box['n']} gears (the contract's defaults, GEARBOX.md §6), "
+    print(f"\nGearbox demo: {fmu}, {box['n']} gears (the contract's defaults, docs/GEARBOX.md §6), "
           f"{T_END:g} s per run, statistics from {STATS_FROM:g} s")
     figures, curves = [], {}
     for T in TEMPERATURES:

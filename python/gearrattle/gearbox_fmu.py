@@ -1,5 +1,5 @@
 """GearboxRattle.fmu run through fmpy, as the tests, the demo and the benchmark read it:
-the contract's per-gear outputs (`gear[i].NAME`, GEARBOX.md §7) gathered into arrays of one
+the contract's per-gear outputs (`gear[i].NAME`, docs/GEARBOX.md §7) gathered into arrays of one
 row per gear."""
 
 from __future__ import annotations

@@ -1,10 +1,10 @@
-"""Independent high-accuracy reference of the gearbox model (shared/GEARBOX.md).
+"""Independent high-accuracy reference of the gearbox model (docs/GEARBOX.md).
 
-Written from GEARBOX.md §1-§6 and MODEL.md §1-§3 alone (not from the Rust code), to check
+Written from docs/GEARBOX.md §1-§6 and docs/MODEL.md §1-§3 alone (not from the Rust code), to check
 the GearboxRattle FMU against. Parameters are keyed by the FMU's contract names
 (`DEFAULTS`, gears as "gear[i].X" with i = 1..n_gears).
 
-Coordinates are relative (GEARBOX.md §3): the state is
+Coordinates are relative (docs/GEARBOX.md §3): the state is
 
     y = [phi, phi_dot, w_F, q_F, xi_1..xi_N, xi_dot_1..xi_dot_N, quadratures]
 
@@ -22,7 +22,7 @@ Coordinates are relative (GEARBOX.md §3): the state is
   and per gear D_contact_i = int s C_LM xi_dot^2 dt, D_lubricant_i = int C (omega_L -
   omega_S)^2 dt, W_ext_i = int (B omega_L - C (omega_L - omega_S) omega_S) dt.
 
-Then, with T_cl, F_i, c_I(T) and C_i(T) of §2, §5 and MODEL.md §2:
+Then, with T_cl, F_i, c_I(T) and C_i(T) of §2, §5 and docs/MODEL.md §2:
 
     omega_L,i = (xi_dot_i + r_M,i rho_i omega_I) / r_L,i
     omega_I'  = (T_cl + sum_i rho_i r_M,i F_i - c_I omega_I) / I_I
@@ -45,7 +45,7 @@ touch) is not skipped. The crossing is located by a root search on the dense out
 the state there is reached by a step of the method from the step's start (the dense
 output's error, carried on at every restart, would limit the accuracy).
 
-Impacts are contact onsets (MODEL.md §1): a gear leaving the gap downwards through 0 (flank
+Impacts are contact onsets (docs/MODEL.md §1): a gear leaving the gap downwards through 0 (flank
 F+) or upwards through G (flank F-).
 """
 
@@ -61,7 +61,7 @@ from scipy.optimize import brentq
 
 from gearrattle.reference import FMINUS, FPLUS, _contact, _regions, contact_force
 
-# GEARBOX.md §6, per gear: (ratio r_L/r_M, r_M, r_L, I_L, G, C_LM, C at 40 °C)
+# docs/GEARBOX.md §6, per gear: (ratio r_L/r_M, r_M, r_L, I_L, G, C_LM, C at 40 °C)
 _TABLE = [
     (3.50, 0.012, 0.042, 0.75e-3, 80e-6, 90.0, 2e-3),
     (2.00, 0.018, 0.036, 0.40e-3, 80e-6, 80.0, 2e-3),
@@ -81,7 +81,7 @@ def _gear_defaults(i: int, row) -> dict:
     return {f"gear[{i}].{k}": v for k, v in g.items()}
 
 
-# The five-speed box of GEARBOX.md §6 (and the engine of §4, the oil of §5).
+# The five-speed box of docs/GEARBOX.md §6 (and the engine of §4, the oil of §5).
 DEFAULTS = dict(
     n_gears=5,
     I_I=0.008,
@@ -112,7 +112,7 @@ DEFAULTS = dict(
 for _i, _row in enumerate(_TABLE, start=1):
     DEFAULTS.update(_gear_defaults(_i, _row))
 
-# Scenes: B1, B2 of GEARBOX.md §8 and R1, a run-down from 800 to 500 rpm over 2 s.
+# Scenes: B1, B2 of docs/GEARBOX.md §8 and R1, a run-down from 800 to 500 rpm over 2 s.
 SCENES = {
     "B1": dict(),
     "B2": dict(T_oil=-10.0),
@@ -143,7 +143,7 @@ def params(scene: str | None = None, **overrides) -> dict:
 
 
 def gear(p: dict, i: int) -> dict:
-    """Gear i's parameters (1-based) under MODEL.md's names, its drag C at the oil's
+    """Gear i's parameters (1-based) under docs/MODEL.md's names, its drag C at the oil's
     temperature (§5) and omega_S = sigma omega_out: the dict `gearrattle.reference` reads."""
     g = {k: p[f"gear[{i}].{k}"] for k in GEAR_KEYS}
     g["C"] = g["C"] * viscosity_factor(p)
@@ -157,7 +157,7 @@ def gear(p: dict, i: int) -> dict:
 
 
 def viscosity_factor(p: dict, T=None):
-    """nu(T) / nu_40 of Vogel's law (GEARBOX.md §5, c = 95 °C); T defaults to p["T_oil"]."""
+    """nu(T) / nu_40 of Vogel's law (docs/GEARBOX.md §5, c = 95 °C); T defaults to p["T_oil"]."""
     T = p["T_oil"] if T is None else np.asarray(T, dtype=float)
     b = math.log(p["nu_40"] / p["nu_100"]) / (1.0 / 135.0 - 1.0 / 195.0)
     return np.exp(b * (1.0 / (T + 95.0) - 1.0 / 135.0))
@@ -169,14 +169,14 @@ def _orders(p: dict):
 
 
 def engine_start(p: dict):
-    """Omega_0 [rad/s], Omega' [rad/s^2] and omega_F(0) of GEARBOX.md §4."""
+    """Omega_0 [rad/s], Omega' [rad/s^2] and omega_F(0) of docs/GEARBOX.md §4."""
     om0 = _TWO_PI * p["rpm"] / 60.0
     ramp = _TWO_PI * p["rpm_rate"] / 60.0
     return om0, ramp, om0 + sum(a / (n * om0) * math.sin(ph) for n, a, ph in _orders(p))
 
 
 def engine_acceleration(t, p: dict):
-    """alpha_F(t) = Omega' + sum_k a_k cos(psi_k) (GEARBOX.md §4, vectorised)."""
+    """alpha_F(t) = Omega' + sum_k a_k cos(psi_k) (docs/GEARBOX.md §4, vectorised)."""
     t = np.asarray(t, dtype=float)
     om0, ramp, _ = engine_start(p)
     angle = om0 * t + 0.5 * ramp * t * t
@@ -184,7 +184,7 @@ def engine_acceleration(t, p: dict):
 
 
 def damper_spring(phi, p: dict):
-    """T_k(phi) and V_cl(phi) = int_0^phi T_k (GEARBOX.md §2, vectorised)."""
+    """T_k(phi) and V_cl(phi) = int_0^phi T_k (docs/GEARBOX.md §2, vectorised)."""
     phi = np.asarray(phi, dtype=float)
     k1, k2, phi1 = p["k_1"], p["k_2"], p["phi_1"]
     beyond = np.maximum(np.abs(phi) - phi1, 0.0)
@@ -195,7 +195,7 @@ def damper_spring(phi, p: dict):
 
 
 def damper_torque(phi, phi_dot, p: dict, stage=None):
-    """T_cl of GEARBOX.md §2 (vectorised); stage: the damper's stage where phi sits on an
+    """T_cl of docs/GEARBOX.md §2 (vectorised); stage: the damper's stage where phi sits on an
     edge (default: from phi, the pre-damper at |phi| = phi_1)."""
     phi = np.asarray(phi, dtype=float)
     if stage is None:
@@ -211,7 +211,7 @@ def stage_of(phi, p: dict):
 
 
 def contact_potential(xi, g: dict):
-    """V(xi) = int F_k dxi of MODEL.md §2 (zero in the gap): closed form beyond the bands,
+    """V(xi) = int F_k dxi of docs/MODEL.md §2 (zero in the gap): closed form beyond the bands,
     adaptive quadrature inside them (vectorised over xi)."""
     K, alpha, eps, G = g["K_star"], g["alpha"], g["epsilon"], g["G"]
 
@@ -382,7 +382,7 @@ class Result:
         return main / (t1 - t0)
 
     def energy(self) -> dict:
-        """GEARBOX.md §3's terms at the output points: E (mechanical energy), its parts
+        """docs/GEARBOX.md §3's terms at the output points: E (mechanical energy), its parts
         (kinetic, V_cl, V per gear), the quadratures, and balance = E - E(0) - W_F +
         D_damper + D_input + sum(D_contact + D_lubricant - W_ext), zero up to the error."""
         p = self.params
@@ -406,7 +406,7 @@ def simulate(
     rtol: float = 1e-12,
     e_scale: float = 1e-3,
 ) -> Result:
-    """Integrate the gearbox from t = 0 to t_end (start of GEARBOX.md §6: theta_F(0) = 0,
+    """Integrate the gearbox from t = 0 to t_end (start of docs/GEARBOX.md §6: theta_F(0) = 0,
     phi(0) = phi_start, omega_I(0) = omega_F(0) (phi_dot(0) = 0), each gear at rigid meshing
     speed with xi_i(0) = gap_start_i G_i).
 
@@ -609,7 +609,7 @@ def recorded_motion(t, p: dict | None = None, **kw) -> dict:
     res = simulate(p, t_end=float(t[-1]), t_eval=t, **kw)
     n = res.xi.shape[0]
     gs = [gear(p, i + 1) for i in range(n)]
-    # reaction of the gears: MODEL.md §2's force, region from xi (continuous across edges)
+    # reaction of the gears: docs/MODEL.md §2's force, region from xi (continuous across edges)
     reaction = sum(g["rho"] * g["r_M"] * contact_force(res.xi[i], res.xi_dot[i], g) for i, g in enumerate(gs))
     phi_dot = res.omega_F - res.omega_I
     T_cl = damper_torque(res.phi, phi_dot, p)

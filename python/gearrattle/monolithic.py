@@ -1,5 +1,5 @@
 """Monolithic reference of the coupled drivetrain: the Flywheel partner (partners/flywheel)
-and the gear pair (shared/MODEL.md) as ONE ODE, integrated to a tight tolerance with steps
+and the gear pair (docs/MODEL.md) as ONE ODE, integrated to a tight tolerance with steps
 ending exactly on the band edges of the contact law. What the co-simulations are checked
 against (tests/masters) and what scripts/coupling_study.py measures their error from.
 
@@ -216,7 +216,7 @@ def simulate(t_end: float, t_eval=None, pg: dict | None = None, pf: dict | None 
         if not exit_:
             t, z = solver.t, solver.y
             break
-        if code == 2:  # leaving the gap: a contact onset (MODEL.md §1)
+        if code == 2:  # leaving the gap: a contact onset (docs/MODEL.md §1)
             imp_t.append(t)
             imp_fl.append(R.FPLUS if side < 0 else R.FMINUS)
             imp_v.append(abs(z[_V]))

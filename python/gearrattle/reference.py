@@ -1,10 +1,10 @@
-"""Independent high-accuracy reference of the gear-rattle model (shared/MODEL.md).
+"""Independent high-accuracy reference of the gear-rattle model (docs/MODEL.md).
 
-Written from MODEL.md alone (not from the Rust FMU), to check the FMU against.
+Written from docs/MODEL.md alone (not from the Rust FMU), to check the FMU against.
 
 State y = [xi, xi_dot, E_contact, E_lubricant]:
 
-* xi = r_L theta_L - r_M theta_M, the transmission error on the pitch line (MODEL.md §1),
+* xi = r_L theta_L - r_M theta_M, the transmission error on the pitch line (docs/MODEL.md §1),
   integrated directly (relative coordinate, §3 numerical note);
 * E_contact = int s C_LM xi_dot^2 dt and E_lubricant = int C (omega_L - omega_S)^2 dt,
   quadrature states (§3, energy balance).
@@ -32,7 +32,7 @@ current region are watched). The steps are driven by hand with scipy's OdeSolver
 inside one step (a grazing touch: xi_dot changes sign within the step) is not skipped:
 the extremum is located on the dense output and checked against the edges.
 
-Impacts are contact onsets (MODEL.md §1): the gap left downwards through 0 (flank F+) or
+Impacts are contact onsets (docs/MODEL.md §1): the gap left downwards through 0 (flank F+) or
 upwards through G (flank F-); recorded with time, flank and |xi_dot|.
 """
 
@@ -46,7 +46,7 @@ import numpy as np
 from scipy.integrate import DOP853, Radau
 from scipy.optimize import brentq
 
-# The paper's parameters (MODEL.md §4) and the FMU's defaults (modelDescription/GearRattle.toml).
+# The paper's parameters (docs/MODEL.md §4) and the FMU's defaults (modelDescription/GearRattle.toml).
 DEFAULTS = dict(
     I_L=0.32e-3,
     r_L=0.037,
@@ -67,7 +67,7 @@ DEFAULTS = dict(
     I_M=0.008,  # torque mode only: the main shaft's inertia
 )
 
-# Bench scenes (MODEL.md §5).
+# Bench scenes (docs/MODEL.md §5).
 SCENES = {
     "S1": dict(f_exc=30.0, A_rms=300.0),
     "S2": dict(f_exc=60.0, A_rms=300.0),
@@ -101,7 +101,7 @@ def params(scene: str | None = None, **overrides) -> dict:
 
 
 def main_shaft(t, p: dict):
-    """Sine excitation (MODEL.md §5): theta_M, omega_M, alpha_M at time(s) t."""
+    """Sine excitation (docs/MODEL.md §5): theta_M, omega_M, alpha_M at time(s) t."""
     t = np.asarray(t, dtype=float)
     w = _TWO_PI * p["f_exc"]
     amp = math.sqrt(2.0) * p["A_rms"]
@@ -112,7 +112,7 @@ def main_shaft(t, p: dict):
 
 
 def smoothing(xi, p: dict):
-    """Smoothing factor s(xi) of MODEL.md §2 (vectorised)."""
+    """Smoothing factor s(xi) of docs/MODEL.md §2 (vectorised)."""
     xi = np.asarray(xi, dtype=float)
     eps, G = p["epsilon"], p["G"]
     s = np.zeros_like(xi)
@@ -127,7 +127,7 @@ def smoothing(xi, p: dict):
 
 
 def contact_force(xi, xi_dot, p: dict):
-    """Contact force F = F_k + F_c along xi (MODEL.md §2, vectorised)."""
+    """Contact force F = F_k + F_c along xi (docs/MODEL.md §2, vectorised)."""
     xi = np.asarray(xi, dtype=float)
     xi_dot = np.asarray(xi_dot, dtype=float)
     G = p["G"]
@@ -167,7 +167,7 @@ def _regions(p: dict):
 
 
 def _contact(p: dict, code: int):
-    """Contact law of region `code` (MODEL.md §2) as a function (xi, xi_dot) -> (s, F)."""
+    """Contact law of region `code` (docs/MODEL.md §2) as a function (xi, xi_dot) -> (s, F)."""
     K, am1, eps, G = p["K_star"], p["alpha"] - 1.0, p["epsilon"], p["G"]
     C_LM = p["C_LM"]
     inv_G = 1.0 / G
@@ -213,7 +213,7 @@ def _contact(p: dict, code: int):
 def _make_rhs(p: dict, code: int, shaft=None):
     """Right-hand side with the contact formula of region `code` locked.
 
-    shaft: None for the sine excitation of MODEL.md §5, else a function t -> (omega_M, a_M)."""
+    shaft: None for the sine excitation of docs/MODEL.md §5, else a function t -> (omega_M, a_M)."""
     I_L, r_L, r_M = p["I_L"], p["r_L"], p["r_M"]
     C_LM, C, B, om_s = p["C_LM"], p["C"], p["B"], p["omega_S"]
     w = _TWO_PI * p["f_exc"]
@@ -464,7 +464,7 @@ def _piecewise(p, rhs_for, y0, atol, t_start, t_end, t_eval, method, rtol, break
 # Torque mode (the FMU's excitation = 2)
 # ----------------------------------------------------------------------------------------
 #
-# MODEL.md imposes the main shaft; its §3 gives the torque the contact exerts on it,
+# docs/MODEL.md imposes the main shaft; its §3 gives the torque the contact exerts on it,
 # tau_M = + r_M F. In torque mode the shaft is a rigid inertia I_M driven by the drivetrain's
 # torque tau_in and by that reaction:
 #

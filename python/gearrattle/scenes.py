@@ -1,4 +1,4 @@
-"""The paper's bench scenes (MODEL.md section 5: S1 = 30 Hz / 300 rad/s^2 RMS, S2 = 60 Hz / 300,
+"""The paper's bench scenes (docs/MODEL.md section 5: S1 = 30 Hz / 300 rad/s^2 RMS, S2 = 60 Hz / 300,
 S3 = 30 Hz / 500) run through fmpy in sine mode (excitation = 1) with the FMU's start values
 (the paper's parameters), and the rattle statistics of a run: impacts per flank and per
 period, runs on one flank, impact speeds, energies, and consistency checks on the outputs.
@@ -24,7 +24,7 @@ def _scene(name, **facts):
 
 
 # What the paper measured (section 8) and what an independent high-accuracy solution of
-# the model gives (MODEL.md section 5), per scene.
+# the model gives (docs/MODEL.md section 5), per scene.
 SCENES = [
     _scene("S1", figs="Figs. 14-17",
          paper="4 or 5 consecutive impacts on one flank before crossing the gap",
@@ -125,7 +125,7 @@ def analyse(res, scene, p, t_from):
             odd.append(f"impact_speed unchanged at {same} of {n_imp} impacts")
         if np.any(speeds <= 0) or np.any(~np.isfinite(speeds)):
             odd.append("impact_speed <= 0 or not finite at some impacts")
-    # Energy balance (MODEL.md section 3), at the last sample in the gap (no elastic energy):
+    # Energy balance (docs/MODEL.md section 3), at the last sample in the gap (no elastic energy):
     # 1/2 I_L (w_L^2 - w_L0^2) = int(-tau_M w_M) dt - E_contact - E_lubricant (B = 0, w_S = 0).
     gap = np.nonzero(c == 0)[0]
     if len(gap) and p.get("B", 0.0) == 0.0 and p.get("omega_S", 0.0) == 0.0:

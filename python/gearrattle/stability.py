@@ -156,7 +156,7 @@ def write_report(fmu: str = str(S.FMU_PATH), report: str = str(OUT), names: str 
       "rtol 1e-12, Radau at 1e-10 where marked) over the window, divided by max(G, max |ξ_ref|) "
       "(the tolerance is relative: where the teeth go deeper than G, |ξ| is the scale), is at most "
       "10 × rtol, rtol being the tolerance given to the FMU; and the impact counts per flank agree;")
-    w("- **energy** (C = C_LM = 0): the balance of MODEL.md §3 from the FMU's outputs alone, "
+    w("- **energy** (C = C_LM = 0): the balance of docs/MODEL.md §3 from the FMU's outputs alone, "
       "within 10 × rtol (forced: ½ I_L ω_L² + V(ξ) − ∫ −τ_M ω_M dt, the work integrated every 2 µs "
       "with the output derivatives, relative to the largest kinetic energy; shaft at rest: "
       "½ I_L ω_L² + V(ξ) relative to its initial value);")

@@ -4,7 +4,7 @@ Shared by tests/python/test_stress.py (pytest: one test per case) and the stabil
 (gearrattle.stability, docs/STABILITY.md: one row per case), so that the report says exactly
 what the tests check.
 
-Every case runs the FMU in sine mode (excitation = 1, MODEL.md §5) from one scene of
+Every case runs the FMU in sine mode (excitation = 1, docs/MODEL.md §5) from one scene of
 reference.SCENES with parameter overrides, through fmpy's low-level FMU2Slave: every
 fmi2DoStep's status is checked, every output is read at every communication point, the
 FMU's log is recorded. Then:
@@ -16,7 +16,7 @@ FMU's log is recorded. Then:
               to scale = max(G, max |ξ_ref|) (the tolerance is relative: where the teeth go
               deeper than G, as with G = 1 nm, |ξ| is the scale), must be ≤ 10 · rtol, rtol
               being the tolerance given to the FMU; the impact counts per flank must agree;
-    "energy"  C = C_LM = 0 (B = 0): the energy balance of MODEL.md §3 from the FMU's outputs
+    "energy"  C = C_LM = 0 (B = 0): the energy balance of docs/MODEL.md §3 from the FMU's outputs
               alone, within 10 · rtol (see _check_energy);
     "hour"    1 h at an idle mean speed, no drift (see _check_hour);
     "refuse"  the FMU must refuse (a communication step below the resolution of time).
@@ -199,7 +199,7 @@ CASES: list[Case] = [
     # invariants
     Case(
         "energy forced",
-        "C = C_LM = 0 under S1: ½ I_L ω_L² + V(ξ) − ∫ −τ_M ω_M dt constant (MODEL.md §3), the work "
+        "C = C_LM = 0 under S1: ½ I_L ω_L² + V(ξ) − ∫ −τ_M ω_M dt constant (docs/MODEL.md §3), the work "
         "from the outputs every 2 µs and their derivatives; 50 ms, 12 impacts",
         {"C": 0.0, "C_LM": 0.0},
         t_end=0.05,
@@ -667,7 +667,7 @@ def _check_ref(case: Case, driver: Driver) -> Verdict:
 
 
 def potential(xi, p: dict):
-    """V(ξ) = ∫ F_k dξ from the flank's edge (MODEL.md §3), zero in the gap (vectorised)."""
+    """V(ξ) = ∫ F_k dξ from the flank's edge (docs/MODEL.md §3), zero in the gap (vectorised)."""
     from scipy.integrate import quad
 
     xi = np.asarray(xi, dtype=float)
@@ -694,7 +694,7 @@ def potential(xi, p: dict):
 
 
 def _check_energy(case: Case, driver: Driver) -> Verdict:
-    """C = C_LM = 0 (and B = 0): the energy balance of MODEL.md §3 from the FMU's outputs.
+    """C = C_LM = 0 (and B = 0): the energy balance of docs/MODEL.md §3 from the FMU's outputs.
 
     Shaft at rest (A_rms = 0, ω_M = 0): H = ½ I_L ω_L² + V(ξ) must stay at H(0) (no work,
     nothing to integrate: any communication step). Forced: H − ∫ −τ_M ω_M dt must stay at

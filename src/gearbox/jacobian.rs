@@ -1,8 +1,8 @@
 //! ∂f/∂y of the gearbox's right-hand side for Radau IIA, analytic. The structure is an
 //! arrow: each gear's ξ_i, ξ_i' couple with themselves and, through α_I, with φ' and with
 //! every other gear's contact force; φ, φ' couple with every gear through α_I. With
-//! u = ω_I = ω_F − φ' and the slopes of the contact law (MODEL.md §2) and of the damper
-//! (GEARBOX.md §2):
+//! u = ω_I = ω_F − φ' and the slopes of the contact law (docs/MODEL.md §2) and of the damper
+//! (docs/GEARBOX.md §2):
 //!
 //!   ∂α_I/∂φ = T_φ / I_I,  ∂α_I/∂φ' = (T_φ' + c_I) / I_I,
 //!   ∂α_I/∂ξ_j = ρ_j r_M,j F_ξ,j / I_I,  ∂α_I/∂ξ_j' = ρ_j r_M,j F_ξ',j / I_I,

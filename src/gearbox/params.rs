@@ -1,4 +1,4 @@
-//! The gearbox's parameters (GEARBOX.md §1-§6) as one plain struct, its defaults (§6) and
+//! The gearbox's parameters (docs/GEARBOX.md §1-§6) as one plain struct, its defaults (§6) and
 //! the checks the model needs, each error naming the parameter at fault.
 #![allow(non_snake_case)]
 
@@ -10,8 +10,8 @@ use crate::physics::{DamperParams, EngineParams, GearParams, Oil};
 /// The most loose gears a box has.
 pub const MAX_GEARS: usize = 8;
 
-/// One loose gear: its pair's parameters (MODEL.md §4, the drag C given at 40 °C), the
-/// ratio ρ at which its driving gear turns with the input shaft (GEARBOX.md §1) and its
+/// One loose gear: its pair's parameters (docs/MODEL.md §4, the drag C given at 40 °C), the
+/// ratio ρ at which its driving gear turns with the input shaft (docs/GEARBOX.md §1) and its
 /// carrier's ratio σ to the output shaft.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct LooseGear {
@@ -56,7 +56,7 @@ impl std::fmt::Display for GearboxParamError {
 }
 
 impl GearboxParams {
-    /// GEARBOX.md §6: the five-speed box in neutral at idle, oil at 40 °C.
+    /// docs/GEARBOX.md §6: the five-speed box in neutral at idle, oil at 40 °C.
     pub fn default_box() -> Self {
         // ratio, r_M, r_L, I_L, G, C_LM of gears 1-5.
         let table = [

@@ -1,4 +1,4 @@
-//! What a user reads from the gearbox at (t, y) (GEARBOX.md §7): per gear and for the box.
+//! What a user reads from the gearbox at (t, y) (docs/GEARBOX.md §7): per gear and for the box.
 
 use serde::{Deserialize, Serialize};
 

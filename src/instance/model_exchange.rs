@@ -10,7 +10,7 @@
 //! inputs mode the derivatives read θ_M and ω_M as set (α_M is not needed), in the sine mode
 //! the time, in the torque mode the shaft's own states.
 //!
-//! Event indicators: ξ + ε, ξ, ξ − G, ξ − G − ε, the edges of the contact law (MODEL.md §2),
+//! Event indicators: ξ + ε, ξ, ξ − G, ξ − G − ε, the edges of the contact law (docs/MODEL.md §2),
 //! and ξ' in the gap (its turning points, where a touch that stays in a band shows).
 //! The derivatives take the formula of the region ξ is in; at an event the gear pair's
 //! region follows ξ across the edges, and an onset counts an impact, exactly as in
@@ -130,7 +130,7 @@ impl Simulation {
     }
 
     /// dx/dt at the current time and states, with the formula of the region ξ is in: the
-    /// contact force is continuous with a continuous slope across the edges (MODEL.md §2),
+    /// contact force is continuous with a continuous slope across the edges (docs/MODEL.md §2),
     /// so the importer's solver sees a smooth enough right-hand side wherever its trial
     /// points fall, also past an edge it has not located yet.
     pub fn derivatives(&self) -> [f64; NX] {

@@ -31,7 +31,7 @@ pub enum Drive {
     /// The paper's bench: exact sine motion, a function of time.
     Sine(Sine),
     /// The drivetrain's inputs: the shaft's motion at the current time, extrapolated over
-    /// each step as a Taylor polynomial (MODEL.md §5: never a zero-order hold).
+    /// each step as a Taylor polynomial (docs/MODEL.md §5: never a zero-order hold).
     Inputs(Shaft),
     /// The drivetrain's torque on the shaft τ_in at the current time and its rate, ramped
     /// over each step; the shaft's motion follows from I_M ω_M' = τ_in + τ_M.
@@ -260,7 +260,7 @@ pub fn method(solver: i64) -> Method {
 }
 
 impl Simulation {
-    /// Checks the parameters against the contract's ranges and builds the initial state at t0 (MODEL.md §1:
+    /// Checks the parameters against the contract's ranges and builds the initial state at t0 (docs/MODEL.md §1:
     /// ξ(0) = gap_start·G, ξ'(0) = xi_dot_start; in torque mode the shaft starts from the
     /// values of the inputs theta_M and omega_M, θ_M(0) = theta_M, ω_M(0) = omega_M, and
     /// τ_in ramps at `tau_in_rate`, the derivative fmi2SetRealInputDerivatives gave).
@@ -519,7 +519,7 @@ impl Simulation {
         }
     }
 
-    /// Inputs mode (MODEL.md §3 with ξ = r_L θ_L − r_M θ_M at fixed θ_L). ∂τ_M/∂θ_M and
+    /// Inputs mode (docs/MODEL.md §3 with ξ = r_L θ_L − r_M θ_M at fixed θ_L). ∂τ_M/∂θ_M and
     /// ∂τ_M/∂ω_M are the coupling stiffness and damping a master sees.
     fn kinematic_partial(&self, output: u32, input: u32) -> f64 {
         let now = self.now();

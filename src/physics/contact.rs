@@ -1,4 +1,4 @@
-//! Contact law of the tooth pair (MODEL.md §2, the paper's eqs. 5-9 and §6.2).
+//! Contact law of the tooth pair (docs/MODEL.md §2, the paper's eqs. 5-9 and §6.2).
 //!
 //! The transmission error ξ runs through five regions; inside each, the force is a smooth
 //! (analytic) function of ξ and ξ'. The integrator keeps the region fixed for a whole step
@@ -9,7 +9,7 @@ use serde::{Deserialize, Serialize};
 
 use super::GearParams;
 
-/// Where ξ lies: the regions of MODEL.md §2, from flank F+ (ξ ≤ 0) to flank F− (ξ ≥ G).
+/// Where ξ lies: the regions of docs/MODEL.md §2, from flank F+ (ξ ≤ 0) to flank F− (ξ ≥ G).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub enum Region {
     /// ξ < −ε: full contact on flank F+ (s = 1).
@@ -69,7 +69,7 @@ impl ContactForce {
     }
 }
 
-/// The contact law of MODEL.md §2 for one set of parameters, with its constants folded.
+/// The contact law of docs/MODEL.md §2 for one set of parameters, with its constants folded.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ContactLaw {
     K_star: f64,
@@ -202,7 +202,7 @@ impl ContactLaw {
         crate::math::sin_squared(self.half_pi_over_eps * delta)
     }
 
-    /// Contact force for ξ, ξ' with the formula of `region` (MODEL.md §2).
+    /// Contact force for ξ, ξ' with the formula of `region` (docs/MODEL.md §2).
     #[inline]
     pub fn force(&self, region: Region, xi: f64, xi_dot: f64) -> ContactForce {
         let (s, delta) = match region {

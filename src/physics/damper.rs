@@ -1,4 +1,4 @@
-//! The clutch damper between the flywheel and the input side (GEARBOX.md §2): a two-stage
+//! The clutch damper between the flywheel and the input side (docs/GEARBOX.md §2): a two-stage
 //! spring (the pre-damper k_1 over |φ| ≤ φ_1, the main stage k_2 beyond), each stage with its
 //! hysteresis friction H regularised by tanh(φ'/ω_h), and a viscous c_cl:
 //!
@@ -10,7 +10,7 @@
 
 use serde::{Deserialize, Serialize};
 
-/// The damper's parameters (GEARBOX.md §2, §6), in SI units.
+/// The damper's parameters (docs/GEARBOX.md §2, §6), in SI units.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct DamperParams {
     /// Pre-damper (idle stage) stiffness k_1 [N m/rad].
@@ -29,7 +29,7 @@ pub struct DamperParams {
 }
 
 impl DamperParams {
-    /// GEARBOX.md §6: k_1 = 0.5 N m/° over ±3°, k_2 = 15 N m/°, H = 0.2 / 3 N m.
+    /// docs/GEARBOX.md §6: k_1 = 0.5 N m/° over ±3°, k_2 = 15 N m/°, H = 0.2 / 3 N m.
     pub fn default_box() -> Self {
         let per_degree = 180.0 / std::f64::consts::PI;
         DamperParams {
@@ -197,7 +197,7 @@ mod tests {
         Damper::new(DamperParams::default_box())
     }
 
-    /// GEARBOX.md §2 by hand: 2° in the pre-damper is 1 N m, 5° is 0.5·3 + 15·2 = 31.5 N m
+    /// docs/GEARBOX.md §2 by hand: 2° in the pre-damper is 1 N m, 5° is 0.5·3 + 15·2 = 31.5 N m
     /// (−31.5 at −5°); the friction is ±H at speeds well above ω_h, 0 at rest.
     #[test]
     fn torque_by_hand() {

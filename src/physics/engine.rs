@@ -1,4 +1,4 @@
-//! The built-in engine that drives the flywheel (GEARBOX.md §4): a mean speed Ω, optionally
+//! The built-in engine that drives the flywheel (docs/GEARBOX.md §4): a mean speed Ω, optionally
 //! ramped at a constant rate Ω', with two engine orders of angular-acceleration amplitudes
 //! a_k:
 //!
@@ -24,7 +24,7 @@ pub struct EngineOrder {
     pub phase: f64,
 }
 
-/// The engine's parameters (GEARBOX.md §4, §6).
+/// The engine's parameters (docs/GEARBOX.md §4, §6).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct EngineParams {
     /// Mean speed at t = 0 [rpm].
@@ -35,7 +35,7 @@ pub struct EngineParams {
 }
 
 impl EngineParams {
-    /// GEARBOX.md §6: 800 rpm, four cylinders, order 2 at 600 rad/s², order 4 at 120 rad/s².
+    /// docs/GEARBOX.md §6: 800 rpm, four cylinders, order 2 at 600 rad/s², order 4 at 120 rad/s².
     pub fn idle() -> Self {
         EngineParams {
             rpm: 800.0,

@@ -1,4 +1,4 @@
-//! Motion of the main shaft (MODEL.md §5): the paper's bench sine, or a polynomial
+//! Motion of the main shaft (docs/MODEL.md §5): the paper's bench sine, or a polynomial
 //! extrapolation of the drivetrain's inputs over a communication step; in torque mode, the
 //! drivetrain's torque on the shaft, extrapolated linearly over the step.
 

@@ -1,12 +1,12 @@
 //! Free flight in closed form: in the gap the contact force is zero, and the equation of
-//! motion (MODEL.md §3) is linear in ω_L,
+//! motion (docs/MODEL.md §3) is linear in ω_L,
 //!
 //!   I_L ω_L' = B − C (ω_L − ω_S),   i.e.   u' = β − λ u,   u = ω_L − ω_S, λ = C/I_L, β = B/I_L,
 //!
 //! whose solution from u0 at τ = 0 is u(τ) = u0 e^(−λτ) + β φ1(τ), with
 //! φ1(τ) = (1 − e^(−λτ))/λ and its integral φ2(τ) = (τ − φ1(τ))/λ (τ and τ²/2 when C = 0).
 //! The loose gear turns by ω_S τ + u0 φ1 + β φ2, the main shaft by its own motion, so
-//! ξ = r_L θ_L − r_M θ_M follows without integration (MODEL.md §5: the paper's free flight
+//! ξ = r_L θ_L − r_M θ_M follows without integration (docs/MODEL.md §5: the paper's free flight
 //! "with nearly constant, slowly decaying speed", S(t) = S0 e^(−C* t)).
 #![allow(non_snake_case)]
 
@@ -169,7 +169,7 @@ mod tests {
     use super::*;
     use crate::physics::{Polynomial, Shaft, Sine};
 
-    /// The closed form against a fine classical RK4 integration of MODEL.md §3 with F = 0,
+    /// The closed form against a fine classical RK4 integration of docs/MODEL.md §3 with F = 0,
     /// written here from the equations (ξ'' = r_L ω_L' − r_M a_M), for the bench's sine and
     /// a drivetrain's polynomial, with and without B, C and ω_S.
     #[test]

@@ -1,8 +1,8 @@
-//! The physics of the gear pair, as restated in `shared/MODEL.md`: parameters (§4), the
+//! The physics of the gear pair, as restated in `docs/MODEL.md`: parameters (§4), the
 //! contact law (§2), the equation of motion written for the transmission error ξ (§1, §3)
 //! and the excitation of the main shaft (§5), imposed or, in torque mode, an inertia driven
 //! by a torque (motion.rs); the free flight in the gap in closed form (flight.rs). For the
-//! gearbox (`shared/GEARBOX.md`): the clutch damper (damper.rs, §2), the built-in engine
+//! gearbox (`docs/GEARBOX.md`): the clutch damper (damper.rs, §2), the built-in engine
 //! (engine.rs, §4), the oil's viscosity (oil.rs, §5). Knows nothing of integrators or FMI.
 
 pub mod contact;

@@ -1,11 +1,11 @@
-//! Equation of motion of the loose gear (MODEL.md §3, the paper's eq. 1), written for the
+//! Equation of motion of the loose gear (docs/MODEL.md §3, the paper's eq. 1), written for the
 //! transmission error ξ = r_L θ_L − r_M θ_M (eq. 2) so that long runs lose no micrometres:
 //!
 //!   ω_L = (ξ' + r_M ω_M) / r_L
 //!   I_L ω_L' = B − r_L F − C (ω_L − ω_S)
 //!   ξ'' = r_L ω_L' − r_M a_M
 //!
-//! The main shaft's motion θ_M, ω_M, a_M is imposed (MODEL.md §5) or, in torque mode, follows
+//! The main shaft's motion θ_M, ω_M, a_M is imposed (docs/MODEL.md §5) or, in torque mode, follows
 //! from its own equation of motion ([`MainShaft`]).
 #![allow(non_snake_case)]
 
@@ -27,7 +27,7 @@ pub struct Loads {
 }
 
 /// Torque mode: the main shaft as a rigid inertia I_M, driven by the drivetrain's torque τ_in
-/// and by the contact. MODEL.md imposes the shaft; this completes its §3 with the reaction
+/// and by the contact. docs/MODEL.md imposes the shaft; this completes its §3 with the reaction
 /// it states there, τ_M = + r_M F being the torque the contact exerts on the main shaft:
 ///
 ///   I_M ω_M' = τ_in + r_M F
@@ -106,7 +106,7 @@ impl Dynamics {
         (self.respond(force, xi_dot, &shaft), shaft)
     }
 
-    /// The loose gear's response to the contact force and the shaft's motion (MODEL.md §3).
+    /// The loose gear's response to the contact force and the shaft's motion (docs/MODEL.md §3).
     #[inline]
     pub fn respond(&self, force: ContactForce, xi_dot: f64, shaft: &Shaft) -> Loads {
         let p = &self.params;

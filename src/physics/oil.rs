@@ -1,4 +1,4 @@
-//! The oil's viscosity against temperature, Vogel's law (GEARBOX.md §5), and the factor by
+//! The oil's viscosity against temperature, Vogel's law (docs/GEARBOX.md §5), and the factor by
 //! which it scales the drags given at 40 °C.
 
 use serde::{Deserialize, Serialize};
@@ -14,7 +14,7 @@ pub struct Oil {
 }
 
 impl Oil {
-    /// A 75W-80 gear oil (GEARBOX.md §5).
+    /// A 75W-80 gear oil (docs/GEARBOX.md §5).
     pub fn gear_75w80() -> Self {
         Oil {
             nu_40: 55.0,
@@ -43,7 +43,7 @@ impl Oil {
 mod tests {
     use super::*;
 
-    /// GEARBOX.md §5's hand values for ν_40 = 55, ν_100 = 9.5: 29× at −10 °C, 0.27× at
+    /// docs/GEARBOX.md §5's hand values for ν_40 = 55, ν_100 = 9.5: 29× at −10 °C, 0.27× at
     /// 80 °C; exactly 1 at 40 °C and ν_100 at 100 °C.
     #[test]
     fn vogel_gives_the_hand_values() {

@@ -1,4 +1,4 @@
-//! The nine parameters of the paper (MODEL.md §4) plus the external torque B and the
+//! The nine parameters of the paper (docs/MODEL.md §4) plus the external torque B and the
 //! carrier-shaft speed ω_S of the equation of motion (§3). Their ranges are the contract's
 //! (modelDescription/GearRattle.toml), checked by the instance before it builds them.
 #![allow(non_snake_case)]
@@ -33,7 +33,7 @@ pub struct GearParams {
 }
 
 impl GearParams {
-    /// The studied gearbox of the paper (§7), MODEL.md §4.
+    /// The studied gearbox of the paper (§7), docs/MODEL.md §4.
     pub fn paper() -> Self {
         GearParams {
             I_L: 0.32e-3,

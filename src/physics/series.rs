@@ -1,4 +1,4 @@
-//! Taylor coefficients of the motion in full contact (MODEL.md §2-3), for the integrator's
+//! Taylor coefficients of the motion in full contact (docs/MODEL.md §2-3), for the integrator's
 //! Taylor steps. There s = 1 and the penetration δ stays at least ε away from the kink of
 //! δ|δ|^(α−1) at δ = 0, so the solution is analytic and its coefficients follow one from
 //! another:
@@ -6,7 +6,7 @@
 //! - u = |δ|/G > 0 and v = u^α: u v' = α u' v, hence k u₀ v_k = Σ_{j=1..k} (α j − (k − j)) u_j v_{k−j}
 //!   = (α + 1) Σ j u_j v_{k−j} − k Σ u_j v_{k−j};
 //! - F_k = ±K* G v_k (the elastic force, + on F−) plus C_LM (k+1) ξ_{k+1};
-//! - ξ'' = (r_L B − r_L² F − C (ξ' + r_M ω_M − r_L ω_S)) / I_L − r_M a_M (MODEL.md §3 with
+//! - ξ'' = (r_L B − r_L² F − C (ξ' + r_M ω_M − r_L ω_S)) / I_L − r_M a_M (docs/MODEL.md §3 with
 //!   ω_L = (ξ' + r_M ω_M)/r_L) gives ξ_{k+2} = ξ''_k / ((k+1)(k+2)).
 #![allow(non_snake_case)]
 

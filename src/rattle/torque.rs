@@ -1,6 +1,6 @@
 //! Torque mode: the rattling gear pair with the main shaft a rigid inertia I_M driven by the
 //! drivetrain's torque τ_in, as a piecewise-smooth ODE for the integrator. The equations
-//! (MODEL.md §3 with the shaft's own equation of [`MainShaft`]):
+//! (docs/MODEL.md §3 with the shaft's own equation of [`MainShaft`]):
 //!
 //!   ω_L  = (ξ' + r_M ω_M) / r_L
 //!   I_L ω_L' = B − r_L F − C (ω_L − ω_S)

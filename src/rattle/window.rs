@@ -10,7 +10,7 @@ use serde::{Deserialize, Serialize};
 use crate::physics::Region;
 
 /// The quadratures of a gear pair's state, in this order from its `E_CONTACT` component on:
-/// the energies of MODEL.md §3's balance, then the integrals behind the RMS and the standard
+/// the energies of docs/MODEL.md §3's balance, then the integrals behind the RMS and the standard
 /// deviation of the window (carried only by a pair with a window: the first [`ENERGIES`]
 /// are the state of a pair without).
 pub mod quadrature {

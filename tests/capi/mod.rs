@@ -412,7 +412,7 @@ impl Drop for Slave {
 /// Start values: (value reference, value) of Real and of Integer variables.
 pub type Start = (Vec<(u32, f64)>, Vec<(u32, i32)>);
 
-/// Start values of the paper's bench scene S1 in sine mode (MODEL.md §5; f_exc = 30 Hz), or of
+/// Start values of the paper's bench scene S1 in sine mode (docs/MODEL.md §5; f_exc = 30 Hz), or of
 /// a scene like it at another excitation frequency, with ξ(0) moved by `shift` × G, so that
 /// scenes differ from one another.
 pub fn s1_start(f_exc: f64, shift: f64) -> Start {

@@ -1,4 +1,4 @@
-//! MODEL.md's contact law written out again, term by term as printed there (the sine form
+//! docs/MODEL.md's contact law written out again, term by term as printed there (the sine form
 //! of the smoothing factor), independently of the crate's implementation, for the tests to
 //! compare against.
 #![allow(non_snake_case, dead_code)]
@@ -21,7 +21,7 @@ pub const PAPER: Paper = Paper {
     C_LM: 67.0,
 };
 
-/// s(ξ) of MODEL.md §2.
+/// s(ξ) of docs/MODEL.md §2.
 pub fn s(p: &Paper, xi: f64) -> f64 {
     let (e, g) = (p.epsilon, p.G);
     if xi <= -e {

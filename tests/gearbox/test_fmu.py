@@ -1,5 +1,5 @@
 """GearboxRattle.fmu as a user meets it: fmpy's validation, refused parameters named, the
-oil's temperature (GEARBOX.md §5), the FMU state's replay, eight gears, a stiff gear."""
+oil's temperature (docs/GEARBOX.md §5), the FMU state's replay, eight gears, a stiff gear."""
 
 import math
 import re
@@ -54,7 +54,7 @@ def test_invalid_parameter_refused(box_unzipdir, box_md, name, value, named):
 
 
 def _vogel(T, nu_40, nu_100):
-    """nu(T) / nu_40, GEARBOX.md §5 (Vogel's constant 95 °C)."""
+    """nu(T) / nu_40, docs/GEARBOX.md §5 (Vogel's constant 95 °C)."""
     b = math.log(nu_40 / nu_100) / (1 / 135 - 1 / 195)
     return math.exp(b * (1 / (T + 95) - 1 / 135))
 
@@ -63,7 +63,7 @@ def _vogel(T, nu_40, nu_100):
 def test_drag_follows_vogel(box_run, T):
     """At constant engine speed (no engine orders), at t = 0 every body turns at the speed of
     rigid meshing, so the drag on the input side scales with nu(T) / nu_40 alone; the defaults'
-    oil gives 29 times and 0.27 times the 40 °C drag (GEARBOX.md §5)."""
+    oil gives 29 times and 0.27 times the 40 °C drag (docs/GEARBOX.md §5)."""
     flat = dict(a_1=0.0, a_2=0.0)
     warm, other = box_run(1e-3, 1e-4, **flat), box_run(1e-3, 1e-4, T_oil=T, **flat)
     factor = _vogel(T, 55e-6, 9.5e-6)

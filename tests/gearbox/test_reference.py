@@ -1,7 +1,7 @@
 """The FMU against the independent reference (gearrattle.gearbox_reference) on the default
 box warm (B1) and cold (B2) and on a run-down (R1), in both interfaces: each gear's xi within
 1e-4 G_i and its impact counts exact over the scene's pointwise-predictable window, its
-impact rate within the reference's spread over perturbed runs beyond (GEARBOX.md §8)."""
+impact rate within the reference's spread over perturbed runs beyond (docs/GEARBOX.md §8)."""
 
 import numpy as np
 import pytest

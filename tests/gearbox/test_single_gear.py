@@ -1,5 +1,5 @@
 """One loose gear on an imposed input side (n_gears = 1, excitation 2) against GearRattle.fmu
-driven by the same main-shaft motion (excitation 0): the same contact law (MODEL.md §2) on
+driven by the same main-shaft motion (excitation 0): the same contact law (docs/MODEL.md §2) on
 the same motion, fed to both alike by fmpy's input interpolation. The motion is the input
 side's of the coupled default box (B1), recorded from the reference
 (gearbox_reference.recorded_motion).

@@ -6,7 +6,7 @@ from gearrattle import reference as R
 
 
 def shaft(t):
-    """theta_M, omega_M, alpha_M of scene S1's main shaft at t (MODEL.md §5)."""
+    """theta_M, omega_M, alpha_M of scene S1's main shaft at t (docs/MODEL.md §5)."""
     return [float(x[0]) for x in R.main_shaft(np.array([t]), R.params("S1"))]
 
 

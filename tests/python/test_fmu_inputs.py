@@ -1,6 +1,6 @@
 """The FMU in inputs mode (excitation = 0, the default): the master drives the main shaft
 (theta_M, omega_M, alpha_M) at each communication point and the FMU extrapolates it over
-the step (MODEL.md §5, drivetrain coupling)."""
+the step (docs/MODEL.md §5, drivetrain coupling)."""
 
 import numpy as np
 import pytest

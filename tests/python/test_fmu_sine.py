@@ -1,4 +1,4 @@
-"""The FMU in sine mode (excitation = 1, the paper's bench, MODEL.md §5) against the Python
+"""The FMU in sine mode (excitation = 1, the paper's bench, docs/MODEL.md §5) against the Python
 reference (reference.py), run through fmpy on target/fmu/GearRattle.fmu."""
 
 import functools
@@ -128,7 +128,7 @@ def test_sine_first_50ms_matches_reference(fmu_run, scene):
 
 @pytest.mark.parametrize("scene", ["S1", "S3"])
 def test_sine_outputs_consistent(fmu_run, scene):
-    """The outputs agree with each other, with MODEL.md's formulas and with the excitation."""
+    """The outputs agree with each other, with docs/MODEL.md's formulas and with the excitation."""
     p = R.params(scene)
     res = fmu_run("sine", scene, 0.05, DT)
     t = res["time"]
@@ -265,7 +265,7 @@ def test_sine_tolerance_is_honoured(fmu_run, tol, bound):
 def test_sine_shaft_at_speed_relative_coordinates(fmu_run):
     """omega_mean = 1000 rad/s (theta_M reaches 1000 rad in 1 s, r_M theta_M = 28 m) with the
     carrier shaft at the synchronous speed omega_S = omega_mean r_M / r_L: xi obeys exactly
-    the equations of S1, so the whole second must match S1 (MODEL.md §3: integrate a
+    the equations of S1, so the whole second must match S1 (docs/MODEL.md §3: integrate a
     relative coordinate, not theta_L, or the micrometres are lost to cancellation)."""
     w = 1000.0
     ov = dict(omega_mean=w, omega_S=w * P["r_M"] / P["r_L"])

@@ -138,7 +138,7 @@ def test_ramp_is_closer_to_the_smooth_torque_than_the_hold(unzipdir, model_descr
 def test_heavy_shaft_is_the_bench(unzipdir, model_description, vrs):
     """A shaft so heavy that the contact cannot move it, driven by I_M a_M(t) (the bench's
     acceleration) from the bench's initial speed, moves as the bench's sine: torque mode then
-    reproduces scene S1 of the kinematic reference (reference.simulate, MODEL.md §5), which
+    reproduces scene S1 of the kinematic reference (reference.simulate, docs/MODEL.md §5), which
     shares nothing with the torque mode but the contact law. The reference's own torque mode
     agrees with it within 2e-6 G; the FMU within its coupling error: the ramp's curvature,
     A w^2 h^2 / 2 on a_M, is the same as that of the inputs mode's extrapolation, which

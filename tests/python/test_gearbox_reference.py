@@ -1,7 +1,7 @@
 """Checks of the gearbox reference (gearrattle.gearbox_reference) against facts of
-shared/GEARBOX.md that do not come from the reference itself: the energy balance (§3), the
+docs/GEARBOX.md that do not come from the reference itself: the energy balance (§3), the
 damper's free oscillation (§2, linear and two-stage), Vogel's law (§5), the engine's closed
-form (§4) and the impact definition (MODEL.md §1) on a constructed case.
+form (§4) and the impact definition (docs/MODEL.md §1) on a constructed case.
 
 These tests do not need the FMU."""
 
@@ -14,7 +14,7 @@ from scipy.optimize import brentq
 
 from gearrattle import gearbox_reference as B
 
-# every dissipation off (GEARBOX.md §3's strict test)
+# every dissipation off (docs/GEARBOX.md §3's strict test)
 LOSSLESS = dict(c_cl=0.0, H_1=0.0, H_2=0.0, c_I=0.0)
 LOSSLESS.update({f"gear[{i}].{k}": 0.0 for i in range(1, 6) for k in ("C_LM", "C", "B")})
 
@@ -35,7 +35,7 @@ def test_vogel_factors():
 
 
 def test_engine_speed_against_closed_form():
-    """omega_F, theta_F integrated with the state against GEARBOX.md §4's closed form."""
+    """omega_F, theta_F integrated with the state against docs/GEARBOX.md §4's closed form."""
     p = B.params(phase_1=0.7, phase_2=-1.1, **HELD | {"rpm": 800.0, "a_1": 600.0, "a_2": 120.0}, **FLYING)
     t = np.linspace(0.0, 0.3, 301)
     r = B.simulate(p, 0.3, t_eval=t)
@@ -48,7 +48,7 @@ def test_engine_speed_against_closed_form():
     theta_F = om * t - sum(a / (n * om) ** 2 * (np.cos(n * om * t + ph) - math.cos(ph)) for n, a, ph in terms)
     assert np.max(np.abs(r.omega_F - omega_F(t))) < 1e-11 * om
     assert np.max(np.abs(r.theta_F - theta_F)) < 1e-11 * om * 0.3
-    # GEARBOX.md §6's start: the input side at omega_F(0), the gear at rigid meshing speed
+    # docs/GEARBOX.md §6's start: the input side at omega_F(0), the gear at rigid meshing speed
     assert r.omega_I[0] == pytest.approx(omega_F(0.0), rel=1e-15) and r.xi_dot[0, 0] == 0.0
     # alpha_F (the recorded motion's) is the closed form's derivative
     h = 1e-6
@@ -57,7 +57,7 @@ def test_engine_speed_against_closed_form():
 
 def test_engine_ramp_against_quadrature():
     """With a ramp, omega_F(t) - omega_F(0) against a quadrature of alpha_F, written here
-    from GEARBOX.md §4."""
+    from docs/GEARBOX.md §4."""
     p = B.params(rpm_rate=-300.0, phase_1=0.3, **HELD | {"rpm": 800.0, "a_1": 600.0, "a_2": 120.0}, **FLYING)
     t = np.linspace(0.0, 0.5, 6)
     r = B.simulate(p, 0.5, t_eval=t)
@@ -125,7 +125,7 @@ def test_damper_friction_per_stage():
 
 
 def test_energy_balance_lossless():
-    """GEARBOX.md §3: with every dissipation off, E - E(0) = W_F, to 1e-9 of E, the engine
+    """docs/GEARBOX.md §3: with every dissipation off, E - E(0) = W_F, to 1e-9 of E, the engine
     running down. The twist starts beyond phi_1 (without friction the idle stage alone
     would hold it)."""
     p = B.params(phi_start=0.08, n_gears=2, rpm_rate=-300.0, **LOSSLESS)

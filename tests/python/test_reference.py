@@ -1,5 +1,5 @@
 """Checks of the Python reference (reference.py) against the independent facts of
-shared/MODEL.md: the contact law (§2), the energy balance (§3) and the table of §5.
+docs/MODEL.md: the contact law (§2), the energy balance (§3) and the table of §5.
 
 These tests do not need the FMU."""
 
@@ -17,7 +17,7 @@ EPS = P["epsilon"]
 
 
 # ---------------------------------------------------------------------------------------
-# Contact law (MODEL.md §2)
+# Contact law (docs/MODEL.md §2)
 # ---------------------------------------------------------------------------------------
 
 
@@ -56,7 +56,7 @@ def test_contact_force_continuity_and_values():
         assert np.all(R.contact_force(np.linspace(0, G, 11), np.full(11, v), P) == 0.0)
     # full contact: F_k = K* delta |delta/G|^(alpha-1) = K_LM delta |delta|^(alpha-1)
     k_lm = P["K_star"] / G ** (P["alpha"] - 1)
-    assert k_lm == pytest.approx(1.03e8, rel=5e-3)  # MODEL.md §4 (1.026e8, rounded)
+    assert k_lm == pytest.approx(1.03e8, rel=5e-3)  # docs/MODEL.md §4 (1.026e8, rounded)
     for delta in (-3e-6, -10e-6):
         f = R.contact_force([delta], [0.0], P)[0]
         assert f == pytest.approx(k_lm * delta * abs(delta) ** (P["alpha"] - 1), rel=1e-12)
@@ -66,7 +66,7 @@ def test_contact_force_continuity_and_values():
     # damping part: s C_LM xi_dot
     assert R.contact_force([-2 * EPS], [0.1], P)[0] - R.contact_force([-2 * EPS], [0.0], P)[0] == pytest.approx(6.7)
     assert R.contact_force([-EPS / 2], [0.1], P)[0] - R.contact_force([-EPS / 2], [0.0], P)[0] == pytest.approx(3.35)
-    # the damping ratio of MODEL.md §4
+    # the damping ratio of docs/MODEL.md §4
     assert P["C_LM"] / (2 * math.sqrt(P["K_star"] * P["I_L"] / P["r_L"] ** 2)) == pytest.approx(0.04, rel=0.03)
 
 
@@ -85,7 +85,7 @@ def test_locked_region_formulas_match_contact_law():
 
 
 # ---------------------------------------------------------------------------------------
-# Integration accuracy and the energy balance (MODEL.md §3)
+# Integration accuracy and the energy balance (docs/MODEL.md §3)
 # ---------------------------------------------------------------------------------------
 
 
@@ -141,7 +141,7 @@ def test_no_band_variant_runs():
 
 
 # ---------------------------------------------------------------------------------------
-# The table of MODEL.md §5
+# The table of docs/MODEL.md §5
 # ---------------------------------------------------------------------------------------
 
 
@@ -191,7 +191,7 @@ def test_s3_rates_and_runs():
 
 
 def test_s2_rates_and_runs():
-    # MODEL.md: ~125 / ~126 (chaotic: a few % depending on the last digits)
+    # docs/MODEL.md: ~125 / ~126 (chaotic: a few % depending on the last digits)
     r = _scene_rates("S2", 125, 126, rel=0.05)
     runs = np.array(_window_runs(r))
     assert set(runs.tolist()) <= {2, 3}
@@ -199,7 +199,7 @@ def test_s2_rates_and_runs():
 
 
 def test_no_impacts_below_threshold():
-    """MODEL.md §5: the model rattles from about 3.3 rad/s^2 RMS at 30 Hz."""
+    """docs/MODEL.md §5: the model rattles from about 3.3 rad/s^2 RMS at 30 Hz."""
     quiet = R.simulate(R.params("S1", A_rms=2.0), 0.3)
     assert len(quiet.impact_t) == 0
     assert 0 < quiet.xi_min and quiet.xi_max < G

@@ -51,7 +51,7 @@ def test_sound_starts_at_the_first_impact_with_the_default_housing(tmp_path):
 
 
 def test_a_scene_without_impacts_is_silent(tmp_path):
-    # 1 rad/s^2 RMS is below the level from which the bench rattles (MODEL.md section 5)
+    # 1 rad/s^2 RMS is below the level from which the bench rattles (docs/MODEL.md section 5)
     listen("--duration", 0.5, "--set", "A_rms=1", "--out", tmp_path)
     s = sound_json(tmp_path)["scenes"][0]
     assert s["impacts"] == [0]

@@ -104,7 +104,7 @@ def summary_lines(rows, thr, fs, As, p, meta):
     L.append(f"  RMS acceleration vs A_rms {spearman(A, arms):+.2f}, vs displacement "
              f"{spearman(disp, arms):+.2f}; mean impact speed vs A_rms {spearman(A, v):+.2f}, "
              f"vs displacement {spearman(disp, v):+.2f}")
-    L.append("Bench scenes (cells of this map; cf. `make demo` and MODEL.md section 5):")
+    L.append("Bench scenes (cells of this map; cf. `make demo` and docs/MODEL.md section 5):")
     span = meta["duration"] - meta["t_from"]
     for s in SCENES:
         r = next((r for r in ok if r["f_Hz"] == s["f"] and r["A_rms"] == s["A_rms"]), None)

@@ -1,5 +1,5 @@
 //! Model Exchange's Jacobian for fmi2GetDirectionalDerivative: ∂ẋ/∂(x, u) and the outputs'
-//! partials, analytic, from the contact law's slopes (MODEL.md §2,
+//! partials, analytic, from the contact law's slopes (docs/MODEL.md §2,
 //! [`ContactLaw::slopes`](crate::physics::ContactLaw::slopes)) through the equations of
 //! motion (§3) in Model Exchange's coordinates, in the region ξ is in, as the derivatives.
 //!
