@@ -58,7 +58,9 @@ r = simulate_fmu("GearRattle.fmu", stop_time=1.0, output_interval=1e-5,
                  start_values={"excitation": 1, "f_exc": 30.0, "A_rms": 300.0},
                  output=["xi", "a_pitch_L", "impacts_Fplus", "impacts_Fminus"])</pre>
 <h2>Rattle statistics</h2>
-<p>Over the window from <code>stats_from</code> to the current time T long (the outputs
+<p>Set <code>stats_from</code> &ge; 0 to get them (by default, &minus;1, no window is open,
+the outputs read 0 and cost nothing). Over the window from <code>stats_from</code> to the
+current time T long (the outputs
 <code>stat_*</code>, listed below with their formulas): impacts are counted at the located
 contact onsets, with their speeds v = |ξ'|, runs of consecutive impacts on one flank and impact
 energies ½ m_eq v² (m_eq = I_L / r_L²); the RMS of the pitch-line acceleration a = r_L α_L
