@@ -14,12 +14,23 @@ from ..sound.study import COLUMNS, COST
 # rattle map looks first. An FMU without them gets its first metrics drawn.
 FIGURE_METRICS = ["stat_impact_rate_Fplus", "stat_impact_rate_Fminus", "stat_run_mean_Fplus",
                   "stat_run_max_Fplus", "stat_v_mean_Fplus", "stat_rattle_power", "stat_a_rms",
-                  "stat_regime"]
+                  "stat_regime", "stat_loudest_gear"]
 
 
 def figure_metrics(metrics, record):
     drawn = [m for m in FIGURE_METRICS if m in metrics]
     return (drawn or [m for m in metrics if m not in record][:len(FIGURE_METRICS)]) + list(record)
+
+
+def gears_of(st, model):
+    """The gears a gearbox study models (1..n_gears, fixed or the FMU's default); none for a
+    model without gears."""
+    if "gear[1].stat_rattle_power" not in model.outputs:
+        return []
+    n = st.fixed.get("n_gears", (model.parameters["n_gears"].start, ""))[0]
+    if any(a.name == "n_gears" for a in st.axes):
+        n = model.parameters["n_gears"].max
+    return list(range(1, int(n) + 1))
 
 
 def write(st, model, table, wall):
@@ -55,11 +66,11 @@ def write(st, model, table, wall):
             x = x[np.isfinite(x)]
             lines.append(f"  {m:24s} " + (f"{x.min():11.4g} {np.median(x):11.4g} {x.max():11.4g}"
                                           if len(x) else "undefined at every point"))
-    drawn = figure_metrics(metrics, extra)
+    drawn = [m for m in figure_metrics(metrics, extra) if figures.varies(table, m)]
     if st.kind == "map" and metrics:
-        files += figures.map_figures(st, table, drawn)
-    elif st.kind == "doe" and metrics:
-        files += figures.doe_figures(st, table, drawn)
+        files += figures.map_figures(st, model, table, drawn, gears_of(st, model))
+    elif st.kind == "doe" and drawn:
+        files += figures.doe_figures(st, model, table, drawn)
     elif st.kind == "mc" and metrics:
         more, extra = montecarlo.analyse(st, table, metrics, drawn)
         lines += more
