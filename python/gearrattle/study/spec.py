@@ -159,7 +159,8 @@ def parse_exceed(text, where):
 # ------------------------------------------------------------------ the TOML file
 
 KEYS = {"kind", "fmu", "out", "set", "duration", "stats_from", "workers", "scheduler", "seed",
-        "n", "x", "y", "param", "design", "dist", "at", "exceed", "sensitivity", "record"}
+        "n", "x", "y", "param", "design", "dist", "at", "exceed", "sensitivity", "record",
+        "gearbox"}
 
 
 def _locate(lines, key, token=None):
@@ -266,6 +267,10 @@ def from_toml(path, overrides=None):
         st.at.append(({k: float(v) for k, v in point.items()}, at("at", next(iter(point), None))))
     for text, _ in _entries(doc.get("exceed", []), at("exceed"), "exceed"):
         st.exceed.append(parse_exceed(text, at("exceed")))
+    if "gearbox" in doc:
+        from . import gearbox
+
+        gearbox.apply(st, doc["gearbox"])
     rec = doc.get("record", [])
     st.record = [rec] if isinstance(rec, str) else list(rec)
     for key, value in (overrides or {}).items():
@@ -320,6 +325,15 @@ def _check_bounds(name, lo, hi, where, model, what):
         raise StudyError(f"{where}: {what} {name} = {hi:g}{unit} is {side} {v.max:g}: {fix}")
 
 
+def check_value(name, value, where, model):
+    """Refuse a start value the FMU does not take: not a parameter, not whole for an Integer,
+    or out of the contract's range."""
+    _check_name(name, where, model, False)
+    if model.parameters[name].type != "Real" and value != int(value):
+        raise StudyError(f"{where}: {name} = {value:g} must be a whole number")
+    _check_bounds(name, value, value, where, model, "value of")
+
+
 def validate(st, model):
     """Refuse a study that cannot run as meant, before anything runs. Fills in the defaults
     (excitation = 1, stats_from = 0.2 s when the FMU has it)."""
@@ -354,9 +368,7 @@ def validate(st, model):
         if name in seen:
             raise StudyError(f"{where}: {name} is both set and varied (at {seen[name]}): "
                              f"remove one")
-        if model.parameters[name].type != "Real" and value != int(value):
-            raise StudyError(f"{where}: {name} = {value:g} must be a whole number")
-        _check_bounds(name, value, value, where, model, "value of")
+        check_value(name, value, where, model)
     for point, where in st.at:
         for name, value in point.items():
             _check_name(name, where, model, False)
