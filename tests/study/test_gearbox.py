@@ -6,6 +6,7 @@ import os
 import zipfile
 
 import numpy as np
+import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
 
@@ -123,4 +124,40 @@ def test_gearbox_map_has_every_gear_and_the_gear_figure(gearbox_fmu, tmp_path):
     assert all(ax.get_xlabel() == "rpm [rpm]" and ax.get_ylabel() == "T_oil [°C]"
                for ax in panels)
     assert "stat_rattle_power [W]" in [ax.get_ylabel() for ax in fig.axes]  # the colour bar
+    plt.close(fig)
+
+
+def test_figures_say_what_they_show(fmu, tmp_path):
+    """The paper map of GearRattle.fmu: titles in words, units from the model description on
+    every axis and colour bar, no folder path, no panel for a metric constant over the map."""
+    from gearrattle.study import figures, report, spec
+
+    out = str(tmp_path / "map")
+    study("map", "--fmu", fmu, "--x", "f_exc=30:60:3", "--y", "A_rms=100:700:3",
+          "--duration", "0.5", "--workers", "0", "--out", out)
+    table = pq.read_table(os.path.join(out, "points.parquet"))
+    model = read_model(fmu)
+    metrics = [v.name for v in model.metrics]
+    constant = table.set_column(table.column_names.index("stat_rattle_power"),
+                                "stat_rattle_power", pa.array([0.25] * table.num_rows))
+    drawn = report.figure_metrics(constant, metrics, [])
+    assert "stat_rattle_power" not in drawn and "stat_impact_rate_Fplus" in drawn
+    st = spec.Study(kind="map", fmu=fmu, out=out, duration=0.5,
+                    axes=[spec.parse_axis("f_exc=30:60:3", "x"),
+                          spec.parse_axis("A_rms=100:700:3", "y")])
+    drawn = report.figure_metrics(table, metrics, [])
+    plt, fig = figures.map_figure(st, model, table, drawn)
+    panels = [ax for ax in fig.axes if ax.get_title()]
+    assert [ax.get_title() for ax in panels] == [
+        model.outputs[m].description.split(":")[0].split(" (")[0].removesuffix(" in the window")
+        for m in drawn]
+    assert {ax.get_xlabel() for ax in panels} == {"f_exc [Hz]"}
+    assert {ax.get_ylabel() for ax in panels} == {"A_rms [rad/s²]"}
+    bars = {ax.get_ylabel() for ax in fig.axes if not ax.get_title()}
+    assert "stat_impact_rate_Fplus [impacts/s]" in bars
+    if "stat_rattle_power" in drawn:
+        assert "stat_rattle_power [W]" in bars
+    if "stat_a_rms" in drawn:
+        assert "stat_a_rms [m/s²]" in bars
+    assert out not in fig._suptitle.get_text()
     plt.close(fig)

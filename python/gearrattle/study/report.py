@@ -17,9 +17,12 @@ FIGURE_METRICS = ["stat_impact_rate_Fplus", "stat_impact_rate_Fminus", "stat_run
                   "stat_regime", "stat_loudest_gear"]
 
 
-def figure_metrics(metrics, record):
+def figure_metrics(table, metrics, record):
+    """The metrics the figures draw: FIGURE_METRICS (else the first ones) and the recorded
+    outputs, each only where it varies over the study's points."""
     drawn = [m for m in FIGURE_METRICS if m in metrics]
-    return (drawn or [m for m in metrics if m not in record][:len(FIGURE_METRICS)]) + list(record)
+    drawn = (drawn or [m for m in metrics if m not in record][:len(FIGURE_METRICS)]) + list(record)
+    return [m for m in drawn if figures.varies(table, m)]
 
 
 def gears_of(st, model):
@@ -66,13 +69,13 @@ def write(st, model, table, wall):
             x = x[np.isfinite(x)]
             lines.append(f"  {m:24s} " + (f"{x.min():11.4g} {np.median(x):11.4g} {x.max():11.4g}"
                                           if len(x) else "undefined at every point"))
-    drawn = [m for m in figure_metrics(metrics, extra) if figures.varies(table, m)]
+    drawn = figure_metrics(table, metrics, extra)
     if st.kind == "map" and metrics:
         files += figures.map_figures(st, model, table, drawn, gears_of(st, model))
     elif st.kind == "doe" and drawn:
         files += figures.doe_figures(st, model, table, drawn)
     elif st.kind == "mc" and metrics:
-        more, extra = montecarlo.analyse(st, table, metrics, drawn)
+        more, extra = montecarlo.analyse(st, model, table, metrics, drawn)
         lines += more
         files += extra
     path = os.path.join(st.out, "summary.txt")
