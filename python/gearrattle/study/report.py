@@ -25,6 +25,11 @@ def figure_metrics(table, metrics, record):
     return [m for m in drawn if figures.varies(table, m)]
 
 
+def _gear(name):
+    """The gear a metric belongs to (gear[3].stat_regime: 3), None for the box's or model's."""
+    return int(name[5:name.index("]")]) if name.startswith("gear[") else None
+
+
 def gears_of(st, model):
     """The gears a gearbox study models (1..n_gears, fixed or the FMU's default); none for a
     model without gears."""
@@ -62,16 +67,22 @@ def write(st, model, table, wall):
     metrics = [v.name for v in model.metrics] + extra
     if not metrics:
         lines.append("  this FMU has no stat_* outputs: the rows hold the parameters and status")
-    elif ok.any():
-        lines.append(f"  {'metric':24s} {'min':>11s} {'median':>11s} {'max':>11s}")
-        for m in metrics:
+    gears = gears_of(st, model)
+    shown = [m for m in metrics if _gear(m) in [None] + gears]
+    if metrics and ok.any():
+        w = max(24, *map(len, shown))
+        lines.append(f"  {'metric':{w}s} {'min':>11s} {'median':>11s} {'max':>11s}")
+        for m in shown:
             x = column(table, m)[ok]
             x = x[np.isfinite(x)]
-            lines.append(f"  {m:24s} " + (f"{x.min():11.4g} {np.median(x):11.4g} {x.max():11.4g}"
-                                          if len(x) else "undefined at every point"))
+            lines.append(f"  {m:{w}s} " + (f"{x.min():11.4g} {np.median(x):11.4g} {x.max():11.4g}"
+                                           if len(x) else "undefined at every point"))
     drawn = figure_metrics(table, metrics, extra)
+    if st.kind != "map":  # a map draws the gears in map_gears.png
+        drawn += [m for m in (f"gear[{i}].stat_rattle_power" for i in gears)
+                  if figures.varies(table, m)]
     if st.kind == "map" and metrics:
-        files += figures.map_figures(st, model, table, drawn, gears_of(st, model))
+        files += figures.map_figures(st, model, table, drawn, gears)
     elif st.kind == "doe" and drawn:
         files += figures.doe_figures(st, model, table, drawn)
     elif st.kind == "mc" and metrics:
