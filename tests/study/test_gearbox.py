@@ -72,6 +72,14 @@ def test_pack_runs_the_gearbox_with_no_setup(gearbox_fmu, tmp_path):
             if name != P.XML:
                 assert a.read(name) == b.read(name), name
     assert read_model(out).guid == read_model(gearbox_fmu).guid
+    # The study runner sets the packed start values: a point of the packed FMU is the original's
+    # told the TOML's values.
+    for fmu, extra in ((out, []), (gearbox_fmu, [f"--set={n}={v}" for n, v in WANT.items()])):
+        study("map", "--fmu", fmu, "--x", "rpm=800:900:2", "--y", "T_oil=40:40:1",
+              "--duration", "0.4", "--workers", "0", "--out", tmp_path / fmu[-8:], *extra)
+    a_, b_ = (pq.read_table(tmp_path / fmu[-8:] / "points.parquet").drop(["cpu_s", "point_id"])
+              for fmu in (out, gearbox_fmu))
+    assert a_.select(b_.column_names).equals(b_), "the packed FMU's study differs"
 
 
 @pytest.mark.parametrize("text,named,fix", [

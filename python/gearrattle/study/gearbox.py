@@ -79,9 +79,14 @@ def check(values, model):
 
 
 def apply(st, path):
-    """The gearbox's values as the study's fixed start values, under what the study sets,
+    """The gearbox's values as the study's fixed start values."""
+    underlay(st, read(path))
+
+
+def underlay(st, entries):
+    """Start values {name: (value, where)} as the study's fixed ones, under what the study sets,
     varies or samples itself."""
     mine = set(st.fixed) | set(st.varied()) | {n for point, _ in st.at for n in point}
-    for name, entry in read(path).items():
+    for name, entry in entries.items():
         if name not in mine:
             st.fixed[name] = entry

@@ -73,3 +73,33 @@ def main(a):
         print(f"{a.out}: {a.fmu} with {len(values)} start values of {a.gearbox} "
               f"(GUID {model.guid}, kept: the binary checks it)")
     return 0
+
+
+def packed_starts(fmu, model):
+    """{name: start} of the parameters whose start value in the FMU's model description is not
+    the binary's built-in one (a packed FMU's gearbox), read from an instance in initialization
+    mode. The study runner sets them at every point, as a drivetrain tool would."""
+    import shutil
+    import tempfile
+
+    from fmpy import extract
+    from fmpy.fmi2 import FMU2Slave
+
+    path = extract(fmu, unzipdir=tempfile.mkdtemp(prefix="gearrattle-pack-"))
+    try:
+        slave = FMU2Slave(guid=model.guid, unzipDirectory=path,
+                          modelIdentifier=model.model_identifier, instanceName="starts")
+        slave.instantiate()
+        try:
+            slave.setupExperiment(startTime=0.0)
+            slave.enterInitializationMode()
+            real = [v for v in model.parameters.values() if v.type == "Real"]
+            ints = [v for v in model.parameters.values() if v.type != "Real"]
+            built_in = dict(zip((v.name for v in real), slave.getReal([v.vr for v in real])))
+            built_in.update(zip((v.name for v in ints), slave.getInteger([v.vr for v in ints])))
+        finally:
+            slave.freeInstance()
+    finally:
+        shutil.rmtree(path, ignore_errors=True)
+    return {n: v.start for n, v in model.parameters.items()
+            if v.start is not None and built_in[n] != v.start}
