@@ -3,8 +3,6 @@ parameters in [box], each loose gear's in one [[gear]] table (gear 1 first), und
 GearboxRattle's contract. Studies take its values as their fixed start values (`gearbox = ...`
 in a study file, `--gearbox` on the command line); `pack` writes them into an FMU."""
 
-import tomllib
-
 from .errors import StudyError
 
 GEAR_COUNT = "n_gears"
@@ -25,14 +23,9 @@ def _where(path, lines, key, table=None):
 def read(path):
     """The gearbox's start values {name: (value, where)}, n_gears counted from its [[gear]]
     tables. Raises StudyError naming the line and the fix for what is not a gearbox file."""
-    try:
-        text = open(path, encoding="utf-8").read()
-    except OSError as e:
-        raise StudyError(f"{path}: cannot read the gearbox file ({e.strerror})") from None
-    try:
-        doc = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as e:
-        raise StudyError(f"{path}: malformed TOML: {e}. Fix the syntax there") from None
+    from .spec import load_toml
+
+    doc, text = load_toml(path, "gearbox")
     lines = text.splitlines()
     unknown = [k for k in doc if k not in ("box", "gear")]
     if unknown:

@@ -192,17 +192,23 @@ def _entries(value, where, key):
                      f"{{ NAME = \"...\" }}")
 
 
-def from_toml(path, overrides=None):
-    """Read a study file; overrides (from the `run` flags) replace its entries."""
+def load_toml(path, what):
+    """(document, text) of a TOML file (what: "study", "gearbox"), or a StudyError saying why
+    it cannot be read."""
     try:
         text = open(path, encoding="utf-8").read()
     except OSError as e:
-        raise StudyError(f"{path}: cannot read the study file ({e.strerror})") from None
+        raise StudyError(f"{path}: cannot read the {what} file ({e.strerror})") from None
     try:
-        doc = tomllib.loads(text)
+        return tomllib.loads(text), text
     except tomllib.TOMLDecodeError as e:
         raise StudyError(f"{path}: malformed TOML: {e}. Fix the syntax there (strings in "
                          f"quotes, one `key = value` a line, tables as [name])") from None
+
+
+def from_toml(path, overrides=None):
+    """Read a study file; overrides (from the `run` flags) replace its entries."""
+    doc, text = load_toml(path, "study")
     lines = text.splitlines()
 
     def at(key, token=None):
