@@ -7,7 +7,7 @@ import os
 
 import numpy as np
 
-from .labels import axis, words
+from .labels import axis, phrase, words
 from .table import column, ok_rows
 
 COLS = 4
@@ -73,8 +73,8 @@ def map_figure(st, model, table, metrics):
         fig.colorbar(mesh, ax=ax).set_label(axis(model, m), fontsize=8)
         ax.set_title(words(model, m), fontsize=9)
         _label_axes(ax, model, x.name, y.name)
-    fig.suptitle(f"Rattle map over {words(model, x.name).lower()} and "
-                 f"{words(model, y.name).lower()}: {table.num_rows} points of "
+    fig.suptitle(f"Rattle map over {phrase(model, x.name)} and "
+                 f"{phrase(model, y.name)}: {table.num_rows} points of "
                  f"{st.duration:g} s each", fontsize=10)
     return plt, fig
 
@@ -102,7 +102,7 @@ def gear_figure(st, model, table, gears, metric="stat_rattle_power"):
     fig.colorbar(mesh, ax=axes, shrink=0.8, pad=0.02).set_label(axis(model, metric), fontsize=9)
     what = words(model, f"gear[{gears[0]}].{metric}").split(": ", 1)[-1].lower()
     fig.suptitle(f"Which gear rattles where: {what} of each gear and of the box over "
-                 f"{words(model, x.name).lower()} and {words(model, y.name).lower()} "
+                 f"{phrase(model, x.name)} and {phrase(model, y.name)} "
                  f"(grey: no impact)", fontsize=10)
     return plt, fig
 
@@ -143,7 +143,7 @@ def doe_figures(st, model, table, metrics):
             ax.grid(alpha=0.3)
         if other:
             fig.colorbar(sc, ax=axes, label=axis(model, other.name), shrink=0.5, pad=0.01)
-        fig.suptitle(f"Each metric against {words(model, r.name).lower()} ({r.name})"
+        fig.suptitle(f"Each metric against {phrase(model, r.name)} ({r.name})"
                      + (f", coloured by {other.name}" if other else ""), fontsize=10)
         files.append(save(plt, fig, os.path.join(st.out, f"doe_{r.name}.png")))
     return files

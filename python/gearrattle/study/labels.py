@@ -34,6 +34,13 @@ def words(model, name):
     the gear it belongs to; its name where the model does not describe it."""
     var = variable(model, name)
     text = re.split(r":| \(", var.description, maxsplit=1)[0] if var and var.description else ""
-    text = text.removesuffix(" in the window").strip() or name
+    text = re.sub(r" (in|over) the window$", "", text).strip() or name
     gear = re.match(r"gear\[(\d+)\]\.", name)
     return f"gear {gear[1]}: {text}" if gear else text
+
+
+def phrase(model, name):
+    """words() inside a sentence: its first letter in lower case, unless it opens an acronym
+    (RMS stays RMS)."""
+    text = words(model, name)
+    return text if text[1:2].isupper() else text[:1].lower() + text[1:]
