@@ -176,11 +176,11 @@ def test_figures_say_what_they_show(fmu, tmp_path):
 def test_a_study_file_names_its_gearbox(tmp_path):
     """`gearbox = "BOX.toml"`: the box's values are the study's start values, under what the
     study varies or sets itself."""
-    from gearrattle.study import spec
+    from gearrattle.study import cli
 
     path = tmp_path / "study.toml"
     path.write_text(f'kind = "doe"\nfmu = "x.fmu"\nout = "o"\ngearbox = "{_box(tmp_path)}"\n'
                     f'param = ["k_1=15:25"]\nset = {{ I_I = 0.02 }}\nn = 2\n')
-    st = spec.from_toml(str(path))
+    st = cli.from_args(cli.parser().parse_args(["run", str(path)]))
     fixed = {n: v for n, (v, _) in st.fixed.items()}
     assert fixed == {**{n: v for n, v in WANT.items() if n != "k_1"}, "I_I": 0.02}

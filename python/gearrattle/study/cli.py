@@ -99,9 +99,7 @@ def from_args(a):
             st.stats_from = (a.stats_from, f"--stats-from {a.stats_from:g}")
         st.record += a.record
         st.sound = st.sound or a.sound
-        if a.gearbox:
-            gearbox.apply(st, a.gearbox)
-        return st
+        return with_gearbox(st, a.gearbox or st.gearbox)
     st = spec.Study(kind=a.kind, fmu=a.fmu, out=a.out, duration=a.duration, workers=a.workers,
                     scheduler=a.scheduler, record=list(a.record), sound=a.sound)
     for text in a.set:
@@ -121,8 +119,14 @@ def from_args(a):
         st.at = [(spec.parse_at(t, f"--at {t}"), f"--at {t}") for t in a.at]
         st.exceed = [spec.parse_exceed(t, f"--exceed {t}") for t in a.exceed]
         st.n, st.seed, st.sensitivity = a.n, a.seed, a.sensitivity
-    if a.gearbox:
-        gearbox.apply(st, a.gearbox)
+    return with_gearbox(st, a.gearbox)
+
+
+def with_gearbox(st, path):
+    """The study with the gearbox file's values under its own (none without a file)."""
+    if path:
+        st.gearbox = path
+        gearbox.apply(st, path)
     return st
 
 

@@ -86,6 +86,7 @@ class Study:
     record: list = field(default_factory=list)  # outputs recorded besides the stat_* ones
     sound: bool = False  # the sound columns of each point (gearrattle.sound.study)
     source: str = "command line"
+    gearbox: str | None = None  # a gearbox file whose values the study starts from
 
     def varied(self):
         return ([a.name for a in self.axes] + [r.name for r in self.ranges]
@@ -273,10 +274,7 @@ def from_toml(path, overrides=None):
         st.at.append(({k: float(v) for k, v in point.items()}, at("at", next(iter(point), None))))
     for text, _ in _entries(doc.get("exceed", []), at("exceed"), "exceed"):
         st.exceed.append(parse_exceed(text, at("exceed")))
-    if "gearbox" in doc:
-        from . import gearbox
-
-        gearbox.apply(st, doc["gearbox"])
+    st.gearbox = doc.get("gearbox")
     rec = doc.get("record", [])
     st.record = [rec] if isinstance(rec, str) else list(rec)
     for key, value in (overrides or {}).items():
