@@ -19,3 +19,12 @@ def cluster(tmp_path_factory):
     c = LocalhostCluster(tmp_path_factory.mktemp("cluster"))
     yield c
     c.close()
+
+
+@pytest.fixture(scope="session")
+def gearbox_fmu():
+    from support.gearbox import GEARBOX_FMU_PATH
+
+    if not GEARBOX_FMU_PATH.is_file():
+        pytest.fail(f"{GEARBOX_FMU_PATH} is missing: build it as tests/gearbox/conftest.py says")
+    return str(GEARBOX_FMU_PATH)

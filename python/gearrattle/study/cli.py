@@ -4,6 +4,7 @@
     gearrattle-study doe --fmu FMU --param NAME=LO:HI [...] --design lhs|full --n N --out DIR
     gearrattle-study mc  --fmu FMU --dist NAME=normal:MEAN:SD [...] --n N --seed S --out DIR
     gearrattle-study run STUDY.toml
+    gearrattle-study pack BOX.toml --out MyBox.fmu   (GearboxRattle.fmu with a gearbox's values)
     gearrattle-study listen --fmu FMU --duration S --out DIR   (the rattle as sound: docs/SOUND.md)
 
 Results: DIR/points.parquet and DIR/points.csv (one row per point), a summary and figures."""
@@ -13,7 +14,7 @@ import os
 import sys
 import time
 
-from . import spec
+from . import gearbox, pack, spec
 from .errors import StudyError
 from ..sound import listen
 
@@ -35,6 +36,8 @@ def _common(p, toml=False):
                         "0: serial, in this process)")
     p.add_argument("--scheduler", default=None, metavar="ADDRESS",
                    help="run on an existing Dask cluster, e.g. tcp://HOST:8786")
+    p.add_argument("--gearbox", default=None, metavar="BOX.toml",
+                   help="GearboxRattle: the gearbox's start values (examples/gearboxes/)")
     p.add_argument("--record", action="append", default=[], metavar="OUTPUT",
                    help="also record this output at the end of each point (repeatable)")
     p.add_argument("--quiet", action="store_true", help="no progress bar, no summary")
@@ -80,6 +83,7 @@ def parser():
     r.add_argument("study", help="STUDY.toml")
     _common(r, toml=True)
     listen.add_parser(sub)
+    pack.add_parser(sub)
     return ap
 
 
@@ -95,7 +99,7 @@ def from_args(a):
             st.stats_from = (a.stats_from, f"--stats-from {a.stats_from:g}")
         st.record += a.record
         st.sound = st.sound or a.sound
-        return st
+        return with_gearbox(st, a.gearbox or st.gearbox)
     st = spec.Study(kind=a.kind, fmu=a.fmu, out=a.out, duration=a.duration, workers=a.workers,
                     scheduler=a.scheduler, record=list(a.record), sound=a.sound)
     for text in a.set:
@@ -115,6 +119,14 @@ def from_args(a):
         st.at = [(spec.parse_at(t, f"--at {t}"), f"--at {t}") for t in a.at]
         st.exceed = [spec.parse_exceed(t, f"--exceed {t}") for t in a.exceed]
         st.n, st.seed, st.sensitivity = a.n, a.seed, a.sensitivity
+    return with_gearbox(st, a.gearbox)
+
+
+def with_gearbox(st, path):
+    """The study with the gearbox file's values under its own (none without a file)."""
+    if path:
+        st.gearbox = path
+        gearbox.apply(st, path)
     return st
 
 
@@ -127,6 +139,8 @@ def prepare(st):
     with open(st.fmu, "rb") as f:
         data = f.read()
     model = read_model(st.fmu)
+    gearbox.underlay(st, {n: (v, f"{st.fmu}'s start value")
+                          for n, v in pack.packed_starts(st.fmu, model).items()})
     spec.validate(st, model)
     return model, data
 
@@ -136,6 +150,8 @@ def main(argv=None):
     if a.kind == "listen":
         return listen.main(a)
     try:
+        if a.kind == "pack":
+            return pack.main(a)
         st = from_args(a)
         model, data = prepare(st)
     except StudyError as e:

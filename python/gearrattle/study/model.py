@@ -1,5 +1,6 @@
 """What a study needs from the FMU's modelDescription.xml: its GUID, the parameters (type, start,
-range) and the metrics, i.e. every output whose name starts with `stat_`.
+range) and the metrics, i.e. every output whose name, or last component of a structured name
+(`gear[2].stat_rattle_power` of GearboxRattle), starts with `stat_`.
 
 A parameter's range is the statement its description ends with, "(range: I_L > 0)", as the
 contract's generator writes it (exclusive bounds included, which FMI 2.0's min and max cannot
@@ -24,6 +25,7 @@ class Var:
     unit: str | None
     min_exclusive: bool = False  # the value must be > min (else >= min)
     max_exclusive: bool = False  # the value must be < max (else <= max)
+    description: str = ""
 
     def below(self, x):
         """x is under the range's lower end (at it, where the bound is exclusive)."""
@@ -57,6 +59,11 @@ class Model:
     @property
     def has_stats_from(self):
         return STATS_FROM in self.parameters
+
+
+def is_metric(name):
+    """A `stat_*` output, of the model or of one of its parts (`gear[2].stat_regime`)."""
+    return name.rsplit(".", 1)[-1].startswith(METRIC_PREFIX)
 
 
 def _number(text, kind):
@@ -95,10 +102,10 @@ def read_model(fmu):
         lo, lo_open, hi, hi_open = _range(v.name, v.description, _number(v.min, v.type),
                                           _number(v.max, v.type))
         var = Var(v.name, v.valueReference, v.type, _number(v.start, v.type), lo, hi, v.unit,
-                  lo_open, hi_open)
+                  lo_open, hi_open, v.description or "")
         if v.causality == "parameter" and v.variability in ("fixed", "tunable"):
             params[v.name] = var
         elif v.causality == "output":
             outs[v.name] = var
-    metrics = tuple(v for n, v in outs.items() if n.startswith(METRIC_PREFIX))
+    metrics = tuple(v for n, v in outs.items() if is_metric(n))
     return Model(md.guid, md.coSimulation.modelIdentifier, params, outs, metrics)

@@ -10,6 +10,7 @@ import numpy as np
 
 from . import designs
 from .figures import panels, save
+from .labels import axis, words
 from .table import column, ok_rows
 
 PERCENTILES = (1, 5, 25, 50, 75, 95, 99)
@@ -39,7 +40,7 @@ def exceedance(k, n, confidence=CONFIDENCE):
     return k / n, ci.low, ci.high
 
 
-def analyse(st, table, metrics, drawn):
+def analyse(st, model, table, metrics, drawn):
     """Summary lines and files; every metric in the CSVs, those in drawn in the figures."""
     ok = ok_rows(table)
     lines, files, pct_rows, exc_rows, sens_rows = [], [], [], [], []
@@ -65,7 +66,8 @@ def analyse(st, table, metrics, drawn):
             more, rows = _sensitivity(st, table, mask, metrics, label)
             lines += more
             sens_rows += rows
-        files.append(_figure(st, table, sel, drawn, label, len(files)))
+        if drawn:
+            files.append(_figure(st, model, table, sel, drawn, label, len(files)))
     files.append(_csv(st.out, "percentiles.csv", ["operating_point", "metric", "n", "mean", "sd"]
                       + [f"p{p}" for p in PERCENTILES], pct_rows))
     if exc_rows:
@@ -78,7 +80,7 @@ def analyse(st, table, metrics, drawn):
                 ["operating_point", "metric", "parameter", "mu_star", "mu_star_conf", "sigma"])
         files.append(_csv(st.out, "sensitivity.csv", cols, sens_rows))
         if drawn_rows:
-            files.append(_sensitivity_figure(st, drawn_rows))
+            files.append(_sensitivity_figure(st, model, drawn_rows))
     return lines, files
 
 
@@ -123,16 +125,19 @@ def _csv(out, name, header, rows):
     return path
 
 
-def _figure(st, table, sel, metrics, label, k):
+def _figure(st, model, table, sel, metrics, label, k):
     """Histogram and ECDF of each metric: mc_distributions[_k].png."""
     plt, fig, axes = panels(len(metrics))
     for ax, m in zip(axes, metrics):
         x = column(table, m)[sel]
         x = np.sort(x[np.isfinite(x)])
         ax.hist(x, bins=min(40, max(5, len(x) // 20)), color="tab:blue", alpha=0.6)
-        ax.set_xlabel(m, fontsize=8)
+        ax.set_title(words(model, m), fontsize=9)
+        ax.set_xlabel(axis(model, m), fontsize=8)
+        ax.set_ylabel("gearboxes", fontsize=8)
         ax.tick_params(labelsize=7)
         e = ax.twinx()
+        e.set_ylabel("share at or below", fontsize=8)
         e.plot(x, np.arange(1, len(x) + 1) / len(x), color="k", lw=1)
         e.set_ylim(0, 1)
         e.tick_params(labelsize=7)
@@ -146,7 +151,7 @@ def _figure(st, table, sel, metrics, label, k):
     return save(plt, fig, os.path.join(st.out, name))
 
 
-def _sensitivity_figure(st, rows):
+def _sensitivity_figure(st, model, rows):
     """Bars of the indices (S1 and ST, or mu*) per parameter for each metric and operating
     point: mc_sensitivity.png."""
     keys = sorted({(r[0], r[1]) for r in rows})
@@ -165,7 +170,7 @@ def _sensitivity_figure(st, rows):
                    label="mu*")
         ax.set_xticks(x)
         ax.set_xticklabels(names, fontsize=7)
-        ax.set_title(f"{key[1]}" + (f" at {key[0]}" if key[0] else ""), fontsize=8)
+        ax.set_title(words(model, key[1]) + (f" at {key[0]}" if key[0] else ""), fontsize=8)
         ax.tick_params(labelsize=7)
     axes[0].legend(fontsize=7)
     fig.suptitle(f"{'Sobol' if st.sensitivity == 'sobol' else 'Morris'} indices "

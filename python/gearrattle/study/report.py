@@ -14,12 +14,31 @@ from ..sound.study import COLUMNS, COST
 # rattle map looks first. An FMU without them gets its first metrics drawn.
 FIGURE_METRICS = ["stat_impact_rate_Fplus", "stat_impact_rate_Fminus", "stat_run_mean_Fplus",
                   "stat_run_max_Fplus", "stat_v_mean_Fplus", "stat_rattle_power", "stat_a_rms",
-                  "stat_regime"]
+                  "stat_regime", "stat_loudest_gear"]
 
 
-def figure_metrics(metrics, record):
+def figure_metrics(table, metrics, record):
+    """The metrics the figures draw: FIGURE_METRICS (else the first ones) and the recorded
+    outputs, each only where it varies over the study's points."""
     drawn = [m for m in FIGURE_METRICS if m in metrics]
-    return (drawn or [m for m in metrics if m not in record][:len(FIGURE_METRICS)]) + list(record)
+    drawn = (drawn or [m for m in metrics if m not in record][:len(FIGURE_METRICS)]) + list(record)
+    return [m for m in drawn if figures.varies(table, m)]
+
+
+def _gear(name):
+    """The gear a metric belongs to (gear[3].stat_regime: 3), None for the box's or model's."""
+    return int(name[5:name.index("]")]) if name.startswith("gear[") else None
+
+
+def gears_of(st, model):
+    """The gears a gearbox study models (1..n_gears, fixed or the FMU's default); none for a
+    model without gears."""
+    if "gear[1].stat_rattle_power" not in model.outputs:
+        return []
+    n = st.fixed.get("n_gears", (model.parameters["n_gears"].start, ""))[0]
+    if any(a.name == "n_gears" for a in st.axes):
+        n = model.parameters["n_gears"].max
+    return list(range(1, int(n) + 1))
 
 
 def write(st, model, table, wall):
@@ -48,20 +67,26 @@ def write(st, model, table, wall):
     metrics = [v.name for v in model.metrics] + extra
     if not metrics:
         lines.append("  this FMU has no stat_* outputs: the rows hold the parameters and status")
-    elif ok.any():
-        lines.append(f"  {'metric':24s} {'min':>11s} {'median':>11s} {'max':>11s}")
-        for m in metrics:
+    gears = gears_of(st, model)
+    shown = [m for m in metrics if _gear(m) in [None] + gears]
+    if metrics and ok.any():
+        w = max(24, *map(len, shown))
+        lines.append(f"  {'metric':{w}s} {'min':>11s} {'median':>11s} {'max':>11s}")
+        for m in shown:
             x = column(table, m)[ok]
             x = x[np.isfinite(x)]
-            lines.append(f"  {m:24s} " + (f"{x.min():11.4g} {np.median(x):11.4g} {x.max():11.4g}"
-                                          if len(x) else "undefined at every point"))
-    drawn = figure_metrics(metrics, extra)
+            lines.append(f"  {m:{w}s} " + (f"{x.min():11.4g} {np.median(x):11.4g} {x.max():11.4g}"
+                                           if len(x) else "undefined at every point"))
+    drawn = figure_metrics(table, metrics, extra)
+    if st.kind != "map":  # a map draws the gears in map_gears.png
+        drawn += [m for m in (f"gear[{i}].stat_rattle_power" for i in gears)
+                  if figures.varies(table, m)]
     if st.kind == "map" and metrics:
-        files += figures.map_figures(st, table, drawn)
-    elif st.kind == "doe" and metrics:
-        files += figures.doe_figures(st, table, drawn)
+        files += figures.map_figures(st, model, table, drawn, gears)
+    elif st.kind == "doe" and drawn:
+        files += figures.doe_figures(st, model, table, drawn)
     elif st.kind == "mc" and metrics:
-        more, extra = montecarlo.analyse(st, table, metrics, drawn)
+        more, extra = montecarlo.analyse(st, model, table, metrics, drawn)
         lines += more
         files += extra
     path = os.path.join(st.out, "summary.txt")

@@ -86,6 +86,7 @@ class Study:
     record: list = field(default_factory=list)  # outputs recorded besides the stat_* ones
     sound: bool = False  # the sound columns of each point (gearrattle.sound.study)
     source: str = "command line"
+    gearbox: str | None = None  # a gearbox file whose values the study starts from
 
     def varied(self):
         return ([a.name for a in self.axes] + [r.name for r in self.ranges]
@@ -159,7 +160,8 @@ def parse_exceed(text, where):
 # ------------------------------------------------------------------ the TOML file
 
 KEYS = {"kind", "fmu", "out", "set", "duration", "stats_from", "workers", "scheduler", "seed",
-        "n", "x", "y", "param", "design", "dist", "at", "exceed", "sensitivity", "record"}
+        "n", "x", "y", "param", "design", "dist", "at", "exceed", "sensitivity", "record",
+        "gearbox"}
 
 
 def _locate(lines, key, token=None):
@@ -191,17 +193,23 @@ def _entries(value, where, key):
                      f"{{ NAME = \"...\" }}")
 
 
-def from_toml(path, overrides=None):
-    """Read a study file; overrides (from the `run` flags) replace its entries."""
+def load_toml(path, what):
+    """(document, text) of a TOML file (what: "study", "gearbox"), or a StudyError saying why
+    it cannot be read."""
     try:
         text = open(path, encoding="utf-8").read()
     except OSError as e:
-        raise StudyError(f"{path}: cannot read the study file ({e.strerror})") from None
+        raise StudyError(f"{path}: cannot read the {what} file ({e.strerror})") from None
     try:
-        doc = tomllib.loads(text)
+        return tomllib.loads(text), text
     except tomllib.TOMLDecodeError as e:
         raise StudyError(f"{path}: malformed TOML: {e}. Fix the syntax there (strings in "
                          f"quotes, one `key = value` a line, tables as [name])") from None
+
+
+def from_toml(path, overrides=None):
+    """Read a study file; overrides (from the `run` flags) replace its entries."""
+    doc, text = load_toml(path, "study")
     lines = text.splitlines()
 
     def at(key, token=None):
@@ -266,6 +274,7 @@ def from_toml(path, overrides=None):
         st.at.append(({k: float(v) for k, v in point.items()}, at("at", next(iter(point), None))))
     for text, _ in _entries(doc.get("exceed", []), at("exceed"), "exceed"):
         st.exceed.append(parse_exceed(text, at("exceed")))
+    st.gearbox = doc.get("gearbox")
     rec = doc.get("record", [])
     st.record = [rec] if isinstance(rec, str) else list(rec)
     for key, value in (overrides or {}).items():
@@ -320,6 +329,15 @@ def _check_bounds(name, lo, hi, where, model, what):
         raise StudyError(f"{where}: {what} {name} = {hi:g}{unit} is {side} {v.max:g}: {fix}")
 
 
+def check_value(name, value, where, model):
+    """Refuse a start value the FMU does not take: not a parameter, not whole for an Integer,
+    or out of the contract's range."""
+    _check_name(name, where, model, False)
+    if model.parameters[name].type != "Real" and value != int(value):
+        raise StudyError(f"{where}: {name} = {value:g} must be a whole number")
+    _check_bounds(name, value, value, where, model, "value of")
+
+
 def validate(st, model):
     """Refuse a study that cannot run as meant, before anything runs. Fills in the defaults
     (excitation = 1, stats_from = 0.2 s when the FMU has it)."""
@@ -354,9 +372,7 @@ def validate(st, model):
         if name in seen:
             raise StudyError(f"{where}: {name} is both set and varied (at {seen[name]}): "
                              f"remove one")
-        if model.parameters[name].type != "Real" and value != int(value):
-            raise StudyError(f"{where}: {name} = {value:g} must be a whole number")
-        _check_bounds(name, value, value, where, model, "value of")
+        check_value(name, value, where, model)
     for point, where in st.at:
         for name, value in point.items():
             _check_name(name, where, model, False)
