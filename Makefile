@@ -55,9 +55,11 @@ $(FMU3): $(call binaries,GearRattle) $(PACKAGING_SOURCES) | libclang
 	cargo run --release --quiet -p packaging --bin package -- --model GearRattle --fmi 3 $(call package_flags,GearRattle) --out $(FMU3)
 
 # The native library, loaded by the C-API tests (the FMU's linux64 binary is built by
-# mk/portable.mk). cargo decides what to rebuild; this rule always asks it.
+# mk/portable.mk), built as a cdylib alone like the packaged ones: the crate's own crate type is
+# rlib, so that the gearbox, which links it, does not build a second cdylib of it. cargo decides
+# what to rebuild; this rule always asks it.
 $(LIB): FORCE | libclang
-	cargo build --release --lib
+	cargo rustc --release -p gear_rattle --lib --crate-type cdylib
 
 FORCE:
 

@@ -19,7 +19,7 @@ fn cdylib() -> PathBuf {
     let lib = profile_dir().join("libgear_rattle.so");
     assert!(
         lib.exists(),
-        "{} is missing: build it first with `cargo build --release --lib` (make test does)",
+        "{} is missing: build it first with `cargo rustc --release -p gear_rattle --lib --crate-type cdylib` (make test does)",
         lib.display()
     );
     lib
