@@ -3,6 +3,7 @@ with the reference."""
 
 import hashlib
 import inspect
+import os
 import pickle
 
 import numpy as np
@@ -33,8 +34,11 @@ def reference_scene(scene: str, t_end: float, dt: float) -> R.Result:
             return pickle.load(f)
     res = R.scene(scene, t_end, dt)
     CACHE.mkdir(parents=True, exist_ok=True)
-    with open(path, "wb") as f:
+    # Written aside, then renamed: a run started meanwhile never reads half a file.
+    part = path.with_suffix(f".{os.getpid()}.part")
+    with open(part, "wb") as f:
         pickle.dump(res, f)
+    os.replace(part, path)
     return res
 
 
