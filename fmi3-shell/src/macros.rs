@@ -284,15 +284,15 @@ macro_rules! __fmi3_exports {
                 };
             fn fmi3SetTime(time: fmi3Float64) SET_TIME |s| s.set_time(time);
             fn fmi3SetContinuousStates(x: *const fmi3Float64, nx: usize)
-                SET_CONTINUOUS_STATES |s| s.slave.set_continuous_states(array!(x, nx));
+                SET_CONTINUOUS_STATES |s| s.set_continuous_states(array!(x, nx));
             fn fmi3GetContinuousStateDerivatives(derivatives: *mut fmi3Float64, nx: usize) GET_CONTINUOUS
-                |s| s.slave.get_derivatives(array!(mut derivatives, nx));
+                |s| s.get_derivatives(array!(mut derivatives, nx));
             fn fmi3GetEventIndicators(eventIndicators: *mut fmi3Float64, ni: usize) GET_CONTINUOUS
-                |s| s.slave.get_event_indicators(array!(mut eventIndicators, ni));
+                |s| s.get_event_indicators(array!(mut eventIndicators, ni));
             fn fmi3GetContinuousStates(x: *mut fmi3Float64, nx: usize) GET_CONTINUOUS
-                |s| s.slave.get_continuous_states(array!(mut x, nx));
+                |s| s.get_continuous_states(array!(mut x, nx));
             fn fmi3GetNominalsOfContinuousStates(nominals: *mut fmi3Float64, nx: usize) GET_CONTINUOUS
-                |s| s.slave.get_nominals_of_continuous_states(array!(mut nominals, nx));
+                |s| s.get_nominals_of_continuous_states(array!(mut nominals, nx));
             fn fmi3GetNumberOfEventIndicators(n: *mut usize) GET_NUMBER_OF
                 |_| unsafe { e3::number(n, contract::EVENT_INDICATORS) };
             fn fmi3GetNumberOfContinuousStates(n: *mut usize) GET_NUMBER_OF
