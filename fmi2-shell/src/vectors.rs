@@ -67,33 +67,33 @@ impl Continuous for NoContinuous {
 impl<S: Slave> Fmu<S> {
     /// fmi2SetContinuousStates: `x` of the model's length, every value finite.
     pub fn set_continuous_states(&mut self, x: &[f64]) -> FmiResult {
-        let model = self.slave.continuous()?;
-        model.set_continuous_states(&states(x)?);
+        let x = states(x)?;
+        self.slave.continuous()?.set_continuous_states(&x);
         Ok(())
     }
 
     /// fmi2GetContinuousStates.
     pub fn get_continuous_states(&mut self, x: &mut [f64]) -> FmiResult {
-        let model = self.slave.continuous()?;
-        fill("x", x, model.continuous_states())
+        fill("x", x, self.slave.continuous()?.continuous_states())
     }
 
     /// fmi2GetNominalsOfContinuousStates.
     pub fn get_nominals_of_continuous_states(&mut self, x_nominal: &mut [f64]) -> FmiResult {
-        let model = self.slave.continuous()?;
-        fill("x_nominal", x_nominal, model.nominals())
+        fill("x_nominal", x_nominal, self.slave.continuous()?.nominals())
     }
 
     /// fmi2GetDerivatives.
     pub fn get_derivatives(&mut self, dx: &mut [f64]) -> FmiResult {
-        let model = self.slave.continuous()?;
-        fill("derivatives", dx, model.derivatives())
+        fill("derivatives", dx, self.slave.continuous()?.derivatives())
     }
 
     /// fmi2GetEventIndicators.
     pub fn get_event_indicators(&mut self, z: &mut [f64]) -> FmiResult {
-        let model = self.slave.continuous()?;
-        fill("eventIndicators", z, model.event_indicators())
+        fill(
+            "eventIndicators",
+            z,
+            self.slave.continuous()?.event_indicators(),
+        )
     }
 }
 
