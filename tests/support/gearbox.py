@@ -10,6 +10,7 @@ import numpy as np
 
 from gearrattle import gearbox_fmu as GF
 from gearrattle import gearbox_reference as R
+from gearrattle import piecewise
 from gearrattle import reference as gear_reference
 
 GEARBOX_FMU_PATH = GF.GEARBOX_FMU
@@ -28,9 +29,9 @@ CACHE = GF.ROOT / "target" / "test-cache" / "gearbox_reference"
 
 def reference_scene(scene: str, t_end: float, dt: float) -> R.Result:
     """R.scene(scene, t_end, dt), kept on disk under target/test-cache between sessions (its
-    2 s scenes cost some 80 s): the key holds both reference modules' source, so that an edit
-    of the reference recomputes it."""
-    source = "".join(inspect.getsource(m) for m in (R, gear_reference))
+    2 s scenes cost some 80 s): the key holds the source of both reference modules and of
+    their piecewise integration, so that an edit of the reference recomputes it."""
+    source = "".join(inspect.getsource(m) for m in (R, gear_reference, piecewise))
     key = hashlib.sha256(f"{source}|{scene}|{t_end!r}|{dt!r}".encode()).hexdigest()[:20]
     path = CACHE / f"{scene}-{key}.pickle"
     if path.is_file():
