@@ -19,6 +19,10 @@ crate_GearboxRattle := gearbox_rattle
 # The FMU's binaries as built (with line tables, for debugging) and as packaged (stripped).
 FMU_DEBUG := target/fmu/debug
 FMU_STRIPPED := target/fmu/stripped
+# The tests and packaging build in cargo's `quick` profile (Cargo.toml): release's optimization
+# without its LTO, which is for the FMUs' binaries alone.
+CARGO_TEST := cargo test --profile quick
+PACKAGE := cargo run --profile quick --quiet -p packaging --bin package --
 # Fragments in mk/ (one per capability: windows, benchmarks, rattle map) add to these;
 # FMU_PLATFORMS: the platforms of the FMUs' binaries as PLATFORM:EXTENSION (linux64:so...).
 FMU_PLATFORMS :=
@@ -47,12 +51,12 @@ PACKAGING_SOURCES = $(wildcard packaging/src/*.rs packaging/src/bin/*.rs)
 
 define fmu_rule
 target/fmu/$(1).fmu: $(call binaries,$(1)) $(PACKAGING_SOURCES) | libclang
-	cargo run --release --quiet -p packaging --bin package -- --model $(1) $(call package_flags,$(1)) --out $$@
+	$(PACKAGE) --model $(1) $(call package_flags,$(1)) --out $$@
 endef
 $(foreach m,$(MODELS),$(eval $(call fmu_rule,$(m))))
 
 $(FMU3): $(call binaries,GearRattle) $(PACKAGING_SOURCES) | libclang
-	cargo run --release --quiet -p packaging --bin package -- --model GearRattle --fmi 3 $(call package_flags,GearRattle) --out $(FMU3)
+	$(PACKAGE) --model GearRattle --fmi 3 $(call package_flags,GearRattle) --out $(FMU3)
 
 # The native library, loaded by the C-API tests (the FMU's linux64 binary is built by
 # mk/portable.mk), built as a cdylib alone like the packaged ones: the crate's own crate type is
@@ -63,9 +67,21 @@ $(LIB): FORCE | libclang
 
 FORCE:
 
-## demo: the paper's bench scenes and the gearbox's through fmpy: a summary and plots in target/demo
-demo: fmu $(VENV)/.installed
-	$(PY) scripts/demo.py --fmu $(FMU) --out target/demo --box-fmu $(GEARBOX_FMU)
+# The demo's FMUs: the host's linux64 binary alone (target/release), packaged as `make fmu`
+# packages the shipped ones, so that the first result waits for no cross build
+# (docs/DEVELOPING.md).
+HOST_FMU := target/fmu/host
+$(HOST_FMU)/%.fmu: FORCE | libclang
+	cargo rustc --release -p $(crate_$*) --lib --crate-type cdylib
+	$(PACKAGE) --model $* --lib target/release/lib$(crate_$*).so --out $@
+
+## demo: the bench scenes, then the gearbox, through fmpy (summaries, plots, sounds in target/demo), then `make fmu`
+demo: $(VENV)/.installed $(HOST_FMU)/GearRattle.fmu
+	$(PY) scripts/demo.py --fmu $(HOST_FMU)/GearRattle.fmu --out target/demo
+	$(MAKE) --no-print-directory $(HOST_FMU)/GearboxRattle.fmu
+	$(PY) scripts/demo.py --scenes "" --box-fmu $(HOST_FMU)/GearboxRattle.fmu --out target/demo
+	@echo "demo: done; the FMUs for linux64, darwin64 and win64 are built next (make fmu)"
+	$(MAKE) --no-print-directory fmu
 
 ## test: every test: Rust (cargo test) and the FMU as a user runs it (pytest + fmpy)
 test: $(TEST_TARGETS)
@@ -75,8 +91,8 @@ test: $(TEST_TARGETS)
 # gearbox's crate is tested on its own: built with gear_rattle in one cargo call, gear_rattle's
 # `fmu` feature (its exports) would be on for the gearbox too, whose own would clash with them.
 test-rust: $(LIB) | libclang
-	cargo test --release -p gear_rattle -p fmi2-shell -p fmi3-shell
-	cargo test --release -p gearbox_rattle
+	$(CARGO_TEST) -p gear_rattle -p fmi2-shell -p fmi3-shell
+	$(CARGO_TEST) -p gearbox_rattle
 
 test-python: fmu $(VENV)/.installed
 	$(PY) -m pytest -q
