@@ -1,7 +1,7 @@
 # GearRattle: the two commands a newcomer needs are `make demo` and `make test`.
 # Each target installs what it needs on a fresh Debian machine with Rust and Python 3:
 # libclang (for fmi-sys's bindgen) through apt-get when missing, and a .venv with the
-# pinned Python packages of requirements.txt.
+# pinned Python packages of requirements-demo.txt and requirements.txt.
 
 SHELL := /bin/bash
 PYTHON ?= python3
@@ -76,7 +76,7 @@ $(HOST_FMU)/%.fmu: FORCE | libclang
 	$(PACKAGE) --model $* --lib target/release/lib$(crate_$*).so --out $@
 
 ## demo: the bench scenes, then the gearbox, through fmpy (summaries, plots, sounds in target/demo), then `make fmu`
-demo: $(VENV)/.installed $(HOST_FMU)/GearRattle.fmu
+demo: $(VENV)/.demo-installed $(HOST_FMU)/GearRattle.fmu
 	$(PY) scripts/demo.py --fmu $(HOST_FMU)/GearRattle.fmu --out target/demo
 	$(MAKE) --no-print-directory $(HOST_FMU)/GearboxRattle.fmu
 	$(PY) scripts/demo.py --scenes "" --box-fmu $(HOST_FMU)/GearboxRattle.fmu --out target/demo
@@ -99,8 +99,14 @@ test-python: fmu $(VENV)/.installed
 
 setup: libclang $(VENV)/.installed
 
-$(VENV)/.installed: requirements.txt
+# The demo's packages first (requirements-demo.txt), so that `make demo` starts on them alone;
+# everything else on top (requirements.txt includes them).
+$(VENV)/.demo-installed: requirements-demo.txt
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
+	$(PY) -m pip install --quiet --disable-pip-version-check -r requirements-demo.txt
+	touch $@
+
+$(VENV)/.installed: requirements.txt $(VENV)/.demo-installed
 	$(PY) -m pip install --quiet --disable-pip-version-check -r requirements.txt
 	touch $@
 
