@@ -1,7 +1,8 @@
 //! The FMI 3.0 model description of a contract, beside FMI 2.0's ([`super::xml`]): the same
 //! variables, units and capabilities in FMI 3.0's terms.
 //!   - Types: Real is Float64; Integer is Int32, or an Enumeration where the contract lists
-//!     its `items` (declared under TypeDefinitions, named as the variable).
+//!     its `items` (declared under TypeDefinitions, named as the variable, an array's
+//!     variable by its declared name: one type for `gear[1].contact` .. `gear[8].contact`).
 //!   - Value references: one space for all variables ([`crate::contract::fmi3`]); the
 //!     independent variable `time` and Model Exchange's event indicators (Float64 locals
 //!     `event_indicator_k`) are declared beside the contract's.
@@ -41,6 +42,11 @@ fn type_name(v: &Variable) -> &'static str {
         ("Integer", None) => "Int32",
         (other, _) => panic!("{}: type {other} has no FMI 3.0 counterpart here", v.name),
     }
+}
+
+/// The name of an Enumeration variable's type: the variable's name as the contract declares it.
+fn enumeration_type(v: &Variable) -> String {
+    esc(v.element.as_ref().map_or(&v.name, |e| &e.declared))
 }
 
 /// The FMI 3.0 name and value of a capability of the contract (FMI 2.0's names), if FMI 3.0
@@ -118,12 +124,17 @@ pub(super) fn xml(c: &Contract, token: &str) -> String {
         ],
     );
     units(&mut x, c);
-    let enumerations: Vec<&Variable> = c.variable.iter().filter(|v| v.items.is_some()).collect();
+    let mut declared = std::collections::BTreeSet::new();
+    let enumerations: Vec<&Variable> = c
+        .variable
+        .iter()
+        .filter(|v| v.items.is_some() && declared.insert(enumeration_type(v)))
+        .collect();
     if !enumerations.is_empty() {
         x += "  <TypeDefinitions>\n";
         for v in &enumerations {
-            writeln!(x, "    <EnumerationType name=\"{}\">", esc(&v.name)).unwrap();
-            for (k, (name, description)) in v.items.iter().flatten().enumerate() {
+            writeln!(x, "    <EnumerationType name=\"{}\">", enumeration_type(v)).unwrap();
+            for (k, (name, description)) in (v.first_item()..).zip(v.items.iter().flatten()) {
                 writeln!(
                     x,
                     "      <Item name=\"{}\" value=\"{k}\" description=\"{}\"/>",
@@ -145,7 +156,7 @@ pub(super) fn xml(c: &Contract, token: &str) -> String {
     .unwrap();
     for v in &c.variable {
         variable_head(&mut x, type_name(v), v, vr(v));
-        if let Some(name) = v.items.as_ref().map(|_| esc(&v.name)) {
+        if let Some(name) = v.items.as_ref().map(|_| enumeration_type(v)) {
             write!(x, " declaredType=\"{name}\"").unwrap();
         }
         // An enumeration's range is its items.
