@@ -573,6 +573,9 @@ fn log_categories_and_experiment(x: &mut String, c: &Contract) {
     *x += "/>\n";
 }
 
+/// Capabilities of the contract that FMI 3.0 alone has (FMI 2.0's description leaves them out).
+const FMI3_ONLY: [&str; 1] = ["hasEventMode"];
+
 fn xml(c: &Contract, guid: &str) -> String {
     let mut x = String::new();
     let m = &c.model;
@@ -597,7 +600,11 @@ fn xml(c: &Contract, guid: &str) -> String {
         x += "/>\n";
     }
     write!(x, "  <CoSimulation modelIdentifier=\"{}\"", m.identifier).unwrap();
-    for (k, v) in &c.capabilities {
+    for (k, v) in c
+        .capabilities
+        .iter()
+        .filter(|(k, _)| !FMI3_ONLY.contains(&k.as_str()))
+    {
         write!(x, " {k}=\"{}\"", value(v)).unwrap();
     }
     x += "/>\n";

@@ -54,6 +54,17 @@ def test_validates_with_enumerations_and_structured_names(box3_path, box3_md, bo
     assert box3_md.instantiationToken == box_md.guid
 
 
+def test_event_mode_is_refused_with_a_log_line(box3_md, box3_unzipdir):
+    """The gearbox's steps do not end at its impacts: no event mode (hasEventMode false)."""
+    assert not box3_md.coSimulation.hasEventMode
+    messages = []
+    fmu = FMU3Slave(guid=box3_md.instantiationToken, unzipDirectory=box3_unzipdir,
+                    modelIdentifier="GearboxRattle", instanceName="event mode")
+    with pytest.raises(Exception, match="Failed to instantiate"):
+        fmu.instantiate(eventModeUsed=True, logMessage=lambda e, s, c, m: messages.append(m.decode()))
+    assert any("hasEventMode is false" in m for m in messages)
+
+
 def test_co_simulation_equals_fmi2_to_the_bit(box_run, box3_unzipdir, box3_md):
     fmi2 = box_run(0.3, 1e-4, excitation=1)
     fmi3 = GF.simulate(box3_unzipdir, 0.3, 1e-4, model_description=box3_md, excitation=1)

@@ -11,7 +11,8 @@
 //!   - Capabilities renamed where FMI 3.0 renamed them, dropped where it has none (and
 //!     canInterpolateInputs: FMI 3.0 has no fmi3SetInputDerivatives), and the adjoint
 //!     derivatives wherever the directional ones are offered (fmi3-shell computes them from
-//!     those). Co-Simulation declares no event mode and no early return.
+//!     those). Co-Simulation's `hasEventMode` is the contract's (FMI 3.0 only; absent:
+//!     false); no early return after an intermediate update (there is none).
 
 use super::{
     Contract, Variable, attributes, esc, initial_unknowns, log_categories_and_experiment, units,
@@ -60,6 +61,7 @@ fn capability(name: &str, v: &toml::Value) -> Option<(&'static str, String)> {
         "maxOutputDerivativeOrder" => "maxOutputDerivativeOrder",
         "canBeInstantiatedOnlyOncePerProcess" => "canBeInstantiatedOnlyOncePerProcess",
         "needsExecutionTool" => "needsExecutionTool",
+        "hasEventMode" => "hasEventMode",
         "completedIntegratorStepNotNeeded" => {
             let needed = !v.as_bool().expect("a boolean");
             return Some(("needsCompletedIntegratorStep", needed.to_string()));
@@ -118,10 +120,7 @@ pub(super) fn xml(c: &Contract, token: &str) -> String {
         "CoSimulation",
         &m.identifier,
         &c.capabilities,
-        &[
-            ("hasEventMode", "false"),
-            ("canReturnEarlyAfterIntermediateUpdate", "false"),
-        ],
+        &[("canReturnEarlyAfterIntermediateUpdate", "false")],
     );
     units(&mut x, c);
     let mut declared = std::collections::BTreeSet::new();
