@@ -9,8 +9,8 @@ VENV := .venv
 PY := $(VENV)/bin/python
 FMU := target/fmu/GearRattle.fmu
 GEARBOX_FMU := target/fmu/GearboxRattle.fmu
-# The same binaries with the FMI 3.0 model description (fmi3-shell's exports).
-FMU3 := target/fmu/fmi3/GearRattle.fmu
+# The models whose FMU comes in FMI 3.0 too, in target/fmu/fmi3/ (the same binaries, fmi3-shell's exports).
+FMU3_MODELS := GearRattle GearboxRattle
 LIB := target/release/libgear_rattle.so
 # The FMUs `make fmu` builds, by model identifier, and the crate of each one's binary.
 MODELS := GearRattle GearboxRattle
@@ -35,8 +35,8 @@ all: fmu
 # Included before the rules so that the fragments' prerequisites are seen.
 include $(wildcard mk/*.mk)
 
-## fmu: build target/fmu/GearRattle.fmu and GearboxRattle.fmu (FMI 2.0) and target/fmu/fmi3/GearRattle.fmu (FMI 3.0), linux64, darwin64, win64
-fmu: $(foreach m,$(MODELS),target/fmu/$(m).fmu) $(FMU3)
+## fmu: build target/fmu/GearRattle.fmu and GearboxRattle.fmu (FMI 2.0) and the same in target/fmu/fmi3/ (FMI 3.0), linux64, darwin64, win64
+fmu: $(foreach m,$(MODELS),target/fmu/$(m).fmu) $(foreach m,$(FMU3_MODELS),target/fmu/fmi3/$(m).fmu)
 
 # The fragments build the binaries and name their platforms in FMU_PLATFORMS: mk/portable.mk
 # linux64 (for glibc 2.17) and darwin64 with zig, mk/windows.mk win64.
@@ -49,14 +49,13 @@ package_option = $(if $(filter linux64:%,$(1)),--lib,--$(word 1,$(subst :, ,$(1)
 package_flags = $(foreach p,$(FMU_PLATFORMS),$(call package_option,$(p)) $(call binary,$(1),$(p)))
 PACKAGING_SOURCES = $(wildcard packaging/src/*.rs packaging/src/bin/*.rs)
 
+# $(call fmu_rule,MODEL,EDITION,FOLDER): the rule of FOLDER/MODEL.fmu, FMI EDITION (2 or 3).
 define fmu_rule
-target/fmu/$(1).fmu: $(call binaries,$(1)) $(PACKAGING_SOURCES) | libclang
-	$(PACKAGE) --model $(1) $(call package_flags,$(1)) --out $$@
+$(3)/$(1).fmu: $(call binaries,$(1)) $(PACKAGING_SOURCES) | libclang
+	$(PACKAGE) --model $(1) --fmi $(2) $(call package_flags,$(1)) --out $$@
 endef
-$(foreach m,$(MODELS),$(eval $(call fmu_rule,$(m))))
-
-$(FMU3): $(call binaries,GearRattle) $(PACKAGING_SOURCES) | libclang
-	$(PACKAGE) --model GearRattle --fmi 3 $(call package_flags,GearRattle) --out $(FMU3)
+$(foreach m,$(MODELS),$(eval $(call fmu_rule,$(m),2,target/fmu)))
+$(foreach m,$(FMU3_MODELS),$(eval $(call fmu_rule,$(m),3,target/fmu/fmi3)))
 
 # The native library, loaded by the C-API tests (the FMU's linux64 binary is built by
 # mk/portable.mk), built as a cdylib alone like the packaged ones: the crate's own crate type is
