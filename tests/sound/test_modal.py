@@ -147,8 +147,9 @@ def held_start_error(pressure, F, n0, every=1):
 
 
 def test_a_recording_started_under_load_is_the_whole_history_heard_from_then():
-    # The smooth rise and the rest leave the housing silent at n0 (0.5 s): the history's pressure from n0
-    # on is what a recording starting there under the 200 N must give, not a step response.
+    # The smooth rise and the rest leave the housing silent at n0 (0.5 s): the history's
+    # pressure from n0 on is what a recording starting there under the 200 N must give, not a
+    # step response.
     h = 1.0 / (FS * M.SUBSAMPLE)
     n0 = int(0.5 / h)
     F = a_history(n0 + int(0.05 / h), n0, h)

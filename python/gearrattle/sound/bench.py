@@ -59,20 +59,22 @@ def alone(unzipdir, md, values, duration):
 
 def reads_alone(unzipdir, md, values, n):
     """CPU of the reads of n steps of meshes.record (the forces at every step, the counters at
-    every WAV sample) without the steps: what calling the FMU from Python costs."""
-    from .meshes import SUBSAMPLE, meshes
+    every WAV sample) without the steps: what calling the FMU's getters from Python costs."""
+    from .meshes import SUBSAMPLE, _raw_calls, meshes
 
     ms = meshes(md, values)
     inst = _initialised(unzipdir, md, values)
     vr_f = (ctypes.c_uint * len(ms))(*[m.force.valueReference for m in ms])
-    vr_c = (ctypes.c_uint * 2)(*[c.valueReference for c in ms[0].counters])
-    F = np.zeros((n, len(ms)))
-    f_mem, c_buf = ctypes.c_double.from_buffer(F), (ctypes.c_int * 2)()
+    vr_c = (ctypes.c_uint * (2 * len(ms)))(*[c.valueReference for m in ms for c in m.counters])
+    F, C = np.zeros((n, len(ms))), np.zeros(len(vr_c), dtype=np.int32)
+    _, get_real, get_int = _raw_calls(inst)
+    vf, vc, comp = ctypes.addressof(vr_f), ctypes.addressof(vr_c), inst.component
+    f_at, c_at = F.ctypes.data, C.ctypes.data
     t0 = time.process_time()
     for k in range(n):
-        inst.fmi2GetReal(inst.component, vr_f, len(ms), ctypes.byref(f_mem, 8 * len(ms) * k))
+        get_real(comp, vf, len(ms), f_at + 8 * len(ms) * k)
         if k % SUBSAMPLE == 0:
-            inst.fmi2GetInteger(inst.component, vr_c, 2, c_buf)
+            get_int(comp, vc, len(vr_c), c_at)
     cpu = time.process_time() - t0
     _free(inst)
     return cpu

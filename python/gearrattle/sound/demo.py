@@ -37,8 +37,8 @@ def gearbox(box_fmu, out, t_from=BOX_FROM, heard=BOX_HEARD):
     per-gear stems gear_<i>.wav in A/ and B/, ab.wav warm then cold) and
     out/gearbox_{warm,cold}_rattle.wav; (their rows of the table, the warm spectrogram)."""
     where = os.path.join(out, "gearbox_sound")
-    scenes = _listen(["--fmu", box_fmu, "--duration", f"{t_from + heard:g}", "--from", f"{t_from:g}",
-                      "--set", f"T_oil={WARM:g}",
+    scenes = _listen(["--fmu", box_fmu, "--duration", f"{t_from + heard:g}",
+                      "--from", f"{t_from:g}", "--set", f"T_oil={WARM:g}",
                       "--compare", "--b-set", f"T_oil={COLD:g}"], where)
     rows = []
     for (name, T), label, scene in zip((("warm", WARM), ("cold", COLD)), "AB", scenes):
