@@ -5,32 +5,20 @@ within the tolerance of the FMI 2.0 tests; FMU state and serialization replaying
 
 import numpy as np
 import pytest
-from fmpy import extract, read_model_description
 from fmpy.fmi3 import FMU3Slave
 
 from gearrattle import gearbox_fmu as GF
+from support.fmu import session_fixtures
 
 GEARBOX_FMU3_PATH = GF.ROOT / "target" / "fmu" / "fmi3" / "GearboxRattle.fmu"
+BUILD_GEARBOX_FMU3 = (
+    "`make fmu` (or `cargo run --release -p packaging -- --model GearboxRattle --fmi 3 --lib "
+    "target/release/libgearbox_rattle.so`)"
+)
 
 
-@pytest.fixture(scope="module")
-def box3_path():
-    if not GEARBOX_FMU3_PATH.is_file():
-        pytest.fail(f"{GEARBOX_FMU3_PATH} does not exist: build it with `make fmu` (or `cargo run "
-                    "--release -p packaging -- --model GearboxRattle --fmi 3 --lib "
-                    "target/release/libgearbox_rattle.so`)", pytrace=False)
-    return str(GEARBOX_FMU3_PATH)
-
-
-@pytest.fixture(scope="module")
-def box3_md(box3_path):
-    # validate=True: the FMI 3.0 XML schema and FMPy's checks of the description.
-    return read_model_description(box3_path, validate=True)
-
-
-@pytest.fixture(scope="module")
-def box3_unzipdir(box3_path, tmp_path_factory):
-    return extract(box3_path, unzipdir=str(tmp_path_factory.mktemp("GearboxRattle_fmi3")))
+box3_path, box3_md, box3_unzipdir = session_fixtures(
+    GEARBOX_FMU3_PATH, BUILD_GEARBOX_FMU3, ("box3_path", "box3_md", "box3_unzipdir"))
 
 
 def test_validates_with_enumerations_and_structured_names(box3_path, box3_md, box_md):

@@ -41,6 +41,7 @@ def main_shaft_input(scene: str, t_end: float, dt: float = 1e-4, fields=("theta_
 
 
 FMU3_PATH = ROOT / "target" / "fmu" / "fmi3" / "GearRattle.fmu"
+BUILD_FMU3 = "`make fmu` (or `cargo run --release -p packaging -- --model GearRattle --fmi 3`)"
 
 
 def require(path: pathlib.Path, build: str) -> str:
@@ -53,9 +54,10 @@ def require(path: pathlib.Path, build: str) -> str:
 
 def session_fixtures(path: pathlib.Path, build: str, names: tuple):
     """The session fixtures of the FMU at `path`, named `names`: its path ([`require`]), its
-    model description, its extracted directory and its value references by name. A conftest
+    model description (read with FMPy's validation: its checks and the XML schema), its
+    extracted directory and, where `names` has a fourth, its value references by name. A conftest or test module
     binds them: `fmu_path, md, unzipdir, vrs = session_fixtures(...)`."""
-    path_name, md_name, unzip_name, vrs_name = names
+    path_name, md_name, unzip_name, *vrs_name = names
 
     @pytest.fixture(scope="session", name=path_name)
     def fmu_path() -> str:
@@ -73,7 +75,10 @@ def session_fixtures(path: pathlib.Path, build: str, names: tuple):
 
         return extract(request.getfixturevalue(path_name), unzipdir=str(tmp_path_factory.mktemp(f"{path.stem}_fmu")))
 
-    @pytest.fixture(scope="session", name=vrs_name)
+    if not vrs_name:
+        return fmu_path, model_description, unzipdir
+
+    @pytest.fixture(scope="session", name=vrs_name[0])
     def vrs(request) -> dict:
         """name -> value reference."""
         return {v.name: v.valueReference for v in request.getfixturevalue(md_name).modelVariables}
