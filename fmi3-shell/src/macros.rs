@@ -33,7 +33,7 @@ macro_rules! __fmi3_exports {
             pub unsafe extern "C" fn fmi3InstantiateModelExchange(
                 instanceName: fmi3String,
                 instantiationToken: fmi3String,
-                _resourcePath: fmi3String,
+                resourcePath: fmi3String,
                 _visible: fmi3Boolean,
                 loggingOn: fmi3Boolean,
                 instanceEnvironment: fmi3InstanceEnvironment,
@@ -41,7 +41,7 @@ macro_rules! __fmi3_exports {
             ) -> fmi3Instance {
                 unsafe {
                     e3::instantiate::<S>("fmi3InstantiateModelExchange", Ok(Interface::ModelExchange),
-                        instanceName, instantiationToken, loggingOn, instanceEnvironment, logMessage)
+                        instanceName, instantiationToken, resourcePath, loggingOn, instanceEnvironment, logMessage)
                 }
             }
             // Early return is never taken (canReturnEarlyAfterIntermediateUpdate is false), so
@@ -50,7 +50,7 @@ macro_rules! __fmi3_exports {
             pub unsafe extern "C" fn fmi3InstantiateCoSimulation(
                 instanceName: fmi3String,
                 instantiationToken: fmi3String,
-                _resourcePath: fmi3String,
+                resourcePath: fmi3String,
                 _visible: fmi3Boolean,
                 loggingOn: fmi3Boolean,
                 eventModeUsed: fmi3Boolean,
@@ -67,7 +67,7 @@ macro_rules! __fmi3_exports {
                 };
                 unsafe {
                     e3::instantiate::<S>("fmi3InstantiateCoSimulation", wanted,
-                        instanceName, instantiationToken, loggingOn, instanceEnvironment, logMessage)
+                        instanceName, instantiationToken, resourcePath, loggingOn, instanceEnvironment, logMessage)
                 }
             }
             /// Scheduled execution is not offered: no instance.
