@@ -61,24 +61,25 @@ pub unsafe fn check_token<S: Slave>(guid: fmi2String, resources: fmi2String) -> 
     let id = &S::IDENTITY;
     // SAFETY: the importer's string arguments.
     let (guid, resources) = unsafe { (text(guid), text(resources)) };
-    let why = match guid {
-        Some(guid) if guid == id.guid => return Ok(Starts::default()),
-        None => "no GUID".to_string(),
-        Some(guid) => match packed::starts(id, guid, resources) {
-            Ok(starts) => return Ok(starts),
-            Err(Refusal::Invalid(e)) => {
-                return Err(FmiError::error(format!(
-                    "the model description beside the binary (GUID {guid}) has an invalid start value: {}",
-                    e.message
-                )));
-            }
-            Err(Refusal::Mismatch(why)) => why,
-        },
+    let Some(guid) = guid else {
+        return Err(FmiError::error(format!(
+            "no GUID given (NULL or not UTF-8): this binary's is {}",
+            id.guid
+        )));
     };
-    Err(FmiError::error(format!(
-        "GUID {guid:?} is not this binary's {}, and no model description matching it was found beside the binary ({why}): the model description and the binary are from different builds",
-        id.guid
-    )))
+    if guid == id.guid {
+        return Ok(Starts::default());
+    }
+    packed::starts(id, guid, resources).map_err(|refusal| match refusal {
+        Refusal::Invalid(e) => FmiError::error(format!(
+            "the model description beside the binary (GUID {guid}) has an invalid start value: {}",
+            e.message
+        )),
+        Refusal::Mismatch(why) => FmiError::error(format!(
+            "GUID {guid} is not this binary's {}, and no model description matching it was found beside the binary ({why}): the model description and the binary are from different builds",
+            id.guid
+        )),
+    })
 }
 
 pub unsafe fn instantiate<S: Slave>(
