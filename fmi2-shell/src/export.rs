@@ -59,9 +59,8 @@ unsafe fn check_instantiate<S: Slave>(
 /// `guid` and `resources` are NULL or NUL-terminated strings.
 pub unsafe fn check_token<S: Slave>(guid: fmi2String, resources: fmi2String) -> FmiResult<Starts> {
     let id = &S::IDENTITY;
-    // SAFETY: the importer's string arguments.
-    let (guid, resources) = unsafe { (text(guid), text(resources)) };
-    let Some(guid) = guid else {
+    // SAFETY: the importer's string argument.
+    let Some(guid) = (unsafe { text(guid) }) else {
         return Err(FmiError::error(format!(
             "no GUID given (NULL or not UTF-8): this binary's is {}",
             id.guid
@@ -70,13 +69,15 @@ pub unsafe fn check_token<S: Slave>(guid: fmi2String, resources: fmi2String) -> 
     if guid == id.guid {
         return Ok(Starts::default());
     }
+    // SAFETY: the importer's string argument.
+    let resources = unsafe { text(resources) };
     packed::starts(id, guid, resources).map_err(|refusal| match refusal {
         Refusal::Invalid(e) => FmiError::error(format!(
             "the model description beside the binary (GUID {guid}) has an invalid start value: {}",
             e.message
         )),
         Refusal::Mismatch(why) => FmiError::error(format!(
-            "GUID {guid} is not this binary's {}, and no model description matching it was found beside the binary ({why}): the model description and the binary are from different builds",
+            "GUID {guid} does not match this binary's {}, and no model description matching it was found beside the binary ({why}): the model description and the binary are from different builds",
             id.guid
         )),
     })
