@@ -1,7 +1,7 @@
 # GearRattle: the two commands a newcomer needs are `make demo` and `make test`.
 # Each target installs what it needs on a fresh Debian machine with Rust and Python 3:
 # libclang (for fmi-sys's bindgen) through apt-get when missing, and a .venv with the
-# pinned Python packages of requirements.txt.
+# pinned Python packages of requirements-demo.txt and requirements.txt.
 
 SHELL := /bin/bash
 PYTHON ?= python3
@@ -9,8 +9,8 @@ VENV := .venv
 PY := $(VENV)/bin/python
 FMU := target/fmu/GearRattle.fmu
 GEARBOX_FMU := target/fmu/GearboxRattle.fmu
-# The same binaries with the FMI 3.0 model description (fmi3-shell's exports).
-FMU3 := target/fmu/fmi3/GearRattle.fmu
+# The models whose FMU comes in FMI 3.0 too, in target/fmu/fmi3/ (the same binaries, fmi3-shell's exports).
+FMU3_MODELS := GearRattle GearboxRattle
 LIB := target/release/libgear_rattle.so
 # The FMUs `make fmu` builds, by model identifier, and the crate of each one's binary.
 MODELS := GearRattle GearboxRattle
@@ -19,6 +19,10 @@ crate_GearboxRattle := gearbox_rattle
 # The FMU's binaries as built (with line tables, for debugging) and as packaged (stripped).
 FMU_DEBUG := target/fmu/debug
 FMU_STRIPPED := target/fmu/stripped
+# The tests and packaging build in cargo's `quick` profile (Cargo.toml): release's optimization
+# without its LTO, which is for the FMUs' binaries alone.
+CARGO_TEST := cargo test --profile quick
+PACKAGE := cargo run --profile quick --quiet -p packaging --bin package --
 # Fragments in mk/ (one per capability: windows, benchmarks, rattle map) add to these;
 # FMU_PLATFORMS: the platforms of the FMUs' binaries as PLATFORM:EXTENSION (linux64:so...).
 FMU_PLATFORMS :=
@@ -31,8 +35,8 @@ all: fmu
 # Included before the rules so that the fragments' prerequisites are seen.
 include $(wildcard mk/*.mk)
 
-## fmu: build target/fmu/GearRattle.fmu and GearboxRattle.fmu (FMI 2.0) and target/fmu/fmi3/GearRattle.fmu (FMI 3.0), linux64, darwin64, win64
-fmu: $(foreach m,$(MODELS),target/fmu/$(m).fmu) $(FMU3)
+## fmu: build target/fmu/GearRattle.fmu and GearboxRattle.fmu (FMI 2.0) and the same in target/fmu/fmi3/ (FMI 3.0), linux64, darwin64, win64
+fmu: $(foreach m,$(MODELS),target/fmu/$(m).fmu) $(foreach m,$(FMU3_MODELS),target/fmu/fmi3/$(m).fmu)
 
 # The fragments build the binaries and name their platforms in FMU_PLATFORMS: mk/portable.mk
 # linux64 (for glibc 2.17) and darwin64 with zig, mk/windows.mk win64.
@@ -45,14 +49,13 @@ package_option = $(if $(filter linux64:%,$(1)),--lib,--$(word 1,$(subst :, ,$(1)
 package_flags = $(foreach p,$(FMU_PLATFORMS),$(call package_option,$(p)) $(call binary,$(1),$(p)))
 PACKAGING_SOURCES = $(wildcard packaging/src/*.rs packaging/src/bin/*.rs)
 
+# $(call fmu_rule,MODEL,EDITION,FOLDER): the rule of FOLDER/MODEL.fmu, FMI EDITION (2 or 3).
 define fmu_rule
-target/fmu/$(1).fmu: $(call binaries,$(1)) $(PACKAGING_SOURCES) | libclang
-	cargo run --release --quiet -p packaging --bin package -- --model $(1) $(call package_flags,$(1)) --out $$@
+$(3)/$(1).fmu: $(call binaries,$(1)) $(PACKAGING_SOURCES) | libclang
+	$(PACKAGE) --model $(1) --fmi $(2) $(call package_flags,$(1)) --out $$@
 endef
-$(foreach m,$(MODELS),$(eval $(call fmu_rule,$(m))))
-
-$(FMU3): $(call binaries,GearRattle) $(PACKAGING_SOURCES) | libclang
-	cargo run --release --quiet -p packaging --bin package -- --model GearRattle --fmi 3 $(call package_flags,GearRattle) --out $(FMU3)
+$(foreach m,$(MODELS),$(eval $(call fmu_rule,$(m),2,target/fmu)))
+$(foreach m,$(FMU3_MODELS),$(eval $(call fmu_rule,$(m),3,target/fmu/fmi3)))
 
 # The native library, loaded by the C-API tests (the FMU's linux64 binary is built by
 # mk/portable.mk), built as a cdylib alone like the packaged ones: the crate's own crate type is
@@ -63,9 +66,21 @@ $(LIB): FORCE | libclang
 
 FORCE:
 
-## demo: the paper's bench scenes and the gearbox's through fmpy: a summary and plots in target/demo
-demo: fmu $(VENV)/.installed
-	$(PY) scripts/demo.py --fmu $(FMU) --out target/demo --box-fmu $(GEARBOX_FMU)
+# The demo's FMUs: the host's linux64 binary alone (target/release), packaged as `make fmu`
+# packages the shipped ones, so that the first result waits for no cross build
+# (docs/DEVELOPING.md).
+HOST_FMU := target/fmu/host
+$(HOST_FMU)/%.fmu: FORCE | libclang
+	cargo rustc --release -p $(crate_$*) --lib --crate-type cdylib
+	$(PACKAGE) --model $* --lib target/release/lib$(crate_$*).so --out $@
+
+## demo: the bench scenes, then the gearbox, through fmpy (summaries, plots, sounds in target/demo), then `make fmu`
+demo: $(VENV)/.demo-installed $(HOST_FMU)/GearRattle.fmu
+	$(PY) scripts/demo.py --fmu $(HOST_FMU)/GearRattle.fmu --out target/demo
+	$(MAKE) --no-print-directory $(HOST_FMU)/GearboxRattle.fmu
+	$(PY) scripts/demo.py --scenes "" --box-fmu $(HOST_FMU)/GearboxRattle.fmu --out target/demo
+	@echo "demo: done; the FMUs for linux64, darwin64 and win64 are built next (make fmu)"
+	$(MAKE) --no-print-directory fmu
 
 ## test: every test: Rust (cargo test) and the FMU as a user runs it (pytest + fmpy)
 test: $(TEST_TARGETS)
@@ -75,16 +90,22 @@ test: $(TEST_TARGETS)
 # gearbox's crate is tested on its own: built with gear_rattle in one cargo call, gear_rattle's
 # `fmu` feature (its exports) would be on for the gearbox too, whose own would clash with them.
 test-rust: $(LIB) | libclang
-	cargo test --release -p gear_rattle -p fmi2-shell -p fmi3-shell
-	cargo test --release -p gearbox_rattle
+	$(CARGO_TEST) -p gear_rattle -p fmi2-shell -p fmi3-shell
+	$(CARGO_TEST) -p gearbox_rattle
 
 test-python: fmu $(VENV)/.installed
 	$(PY) -m pytest -q
 
 setup: libclang $(VENV)/.installed
 
-$(VENV)/.installed: requirements.txt
+# The demo's packages first (requirements-demo.txt), so that `make demo` starts on them alone;
+# everything else on top (requirements.txt includes them).
+$(VENV)/.demo-installed: requirements-demo.txt
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
+	$(PY) -m pip install --quiet --disable-pip-version-check -r requirements-demo.txt
+	touch $@
+
+$(VENV)/.installed: requirements.txt $(VENV)/.demo-installed
 	$(PY) -m pip install --quiet --disable-pip-version-check -r requirements.txt
 	touch $@
 

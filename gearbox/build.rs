@@ -1,6 +1,6 @@
 //! Build script: the contract `modelDescription/GearboxRattle.toml` becomes the model
 //! description and the Rust constants the instance uses (fmi2-shell's generator), and the
-//! cdylib exports only the `fmi2*` functions.
+//! cdylib exports only the `fmi2*` and `fmi3*` functions.
 
 fn main() {
     println!("cargo:rerun-if-changed=build.rs");

@@ -12,4 +12,4 @@ docs-parameters: | libclang
 
 ## test-generator: the contract generator's tests (fmi2-shell, feature build)
 test-generator: $(VENV)/.installed | libclang
-	FMPY_PYTHON=$(abspath $(PY)) cargo test --release -p fmi2-shell --features build --lib
+	FMPY_PYTHON=$(abspath $(PY)) $(CARGO_TEST) -p fmi2-shell --features build --lib

@@ -1,7 +1,7 @@
 # Reliability checks of the C API (docs/RELIABILITY.md says what each one proves):
 #   make fuzz          libFuzzer + AddressSanitizer over random fmi2 call sequences
 #                      (fuzz/, cargo-fuzz on the nightly toolchain), FUZZ_SECONDS long
-#   make test-memcheck valgrind memcheck over the lifecycle and thread tests (release build)
+#   make test-memcheck valgrind memcheck over the lifecycle and thread tests (quick profile)
 #   make check-memory  test-memcheck, then the same tests under AddressSanitizer (nightly)
 #                      and a Python lifecycle through fmpy under valgrind
 #   make soak          the soak test's figures (it also runs in `cargo test`)
@@ -46,7 +46,7 @@ valgrind:
 
 ## test-memcheck: valgrind memcheck over the lifecycle and thread tests: 0 errors, 0 definitely lost
 test-memcheck: | libclang valgrind
-	cargo test --release $(MEMORY_TESTS) \
+	$(CARGO_TEST) $(MEMORY_TESTS) \
 		--config 'target.$(HOST).runner = "$(MEMCHECK)"' -- --test-threads 1
 
 ## check-memory: test-memcheck, the same tests under AddressSanitizer, fmpy's lifecycle under valgrind
@@ -57,4 +57,4 @@ check-memory: test-memcheck fmu $(VENV)/.installed | nightly
 
 ## soak: 100 000 instance and 1 000 000 FMU-state cycles, resident memory printed and checked
 soak: | libclang
-	cargo test --release --test soak -- --nocapture
+	$(CARGO_TEST) --test soak -- --nocapture

@@ -18,7 +18,7 @@ flywheel-fmu: $(FLYWHEEL_FMU)
 # cargo decides what to rebuild; the model description is written from src/model.rs.
 $(FLYWHEEL_FMU): FORCE
 	cargo build --release -p flywheel
-	cargo run --release --quiet -p packaging --bin package -- --model Flywheel --lib $(FLYWHEEL_LIB) --out $@
+	$(PACKAGE) --model Flywheel --lib $(FLYWHEEL_LIB) --out $@
 
 # The master tests live in pytest's testpaths: `make test-python` runs them, so it needs
 # the partner FMU and the Ecos runtime library too.
@@ -26,7 +26,7 @@ test-python: $(FLYWHEEL_FMU) | libtbb
 
 ## test-flywheel: the partner's own Rust tests (cargo test -p flywheel)
 test-flywheel:
-	cargo test --release -p flywheel
+	$(CARGO_TEST) -p flywheel
 
 ## test-masters: only the coupled runs in fmpy, libcosim and Ecos (tests/masters)
 test-masters: fmu $(FLYWHEEL_FMU) $(VENV)/.installed | libtbb

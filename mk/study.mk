@@ -1,5 +1,5 @@
 # Rattle studies: the gearrattle package in python/ (the `gearrattle-study` command;
-# installed editable into .venv by requirements.txt), its tests (tests/study, run by pytest with
+# installed editable into .venv by requirements-demo.txt), its tests (tests/study, run by pytest with
 # the others: pytest.ini) and its benchmark.
 #   make bench-study          CPU per point and wall times against the sampled engine -> docs/STUDY_BENCH.md
 
@@ -8,7 +8,7 @@ STUDY_BENCH_OUT ?= target/bench-study
 .PHONY: bench-study
 
 # A new console script or dependency of the package needs a reinstall.
-$(VENV)/.installed: python/pyproject.toml
+$(VENV)/.demo-installed: python/pyproject.toml
 
 ## bench-study: the study runner against the sampled engine and the FMU stepped from C -> docs/STUDY_BENCH.md
 bench-study: fmu $(VENV)/.installed

@@ -22,13 +22,18 @@ def main(argv=None):
     ap.add_argument("--interval", type=float, default=1e-5,
                     help="output (communication) interval [s]; impacts are read from the "
                          "integer counters, exact while at most one impact per interval")
-    ap.add_argument("--scenes", default="S1,S2,S3", help="comma-separated subset of S1,S2,S3")
+    ap.add_argument("--scenes", default="S1,S2,S3",
+                    help="comma-separated subset of S1,S2,S3; empty: the gearbox demo alone")
     ap.add_argument("--box-fmu", default=None,
                     help="GearboxRattle.fmu: run the gearbox demo too (idle and run-down at "
                          "40, -10 and 80 °C, docs/GEARBOX.md)")
     args = ap.parse_args(argv)
     if args.duration <= 0:
         ap.error("--duration must be > 0")
+    if not args.scenes.strip():
+        if args.box_fmu is None:
+            ap.error("--scenes is empty: give --box-fmu for the gearbox demo")
+        return demo.run_gearbox(args.box_fmu, args.out)
     return demo.run(args.fmu, args.out, args.duration, args.interval, args.scenes, args.box_fmu)
 
 

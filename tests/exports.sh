@@ -1,7 +1,7 @@
 # The functions each FMU's binaries export, for tests/portable/check.sh and
 # tests/windows/run.sh (sourced): FMI 2.0's (tests/fmi2_functions.txt) for every model, and
 # FMI 3.0's (tests/fmi3_functions.txt) for the models whose library fmi3-shell exports too.
-FMI3_MODELS="GearRattle"
+FMI3_MODELS="GearRattle GearboxRattle"
 
 # $1: the model; prints the functions, sorted, one a line.
 expected_exports() {

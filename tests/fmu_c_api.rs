@@ -9,14 +9,13 @@ use packaging::{Binary, models, write_fmu};
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
-/// target/<profile>, from this test executable's path (target/<profile>/deps/…).
-fn profile_dir() -> PathBuf {
-    let exe = std::env::current_exe().unwrap();
-    exe.parent().unwrap().parent().unwrap().to_path_buf()
-}
-
+/// The shipped cdylib, target/release/libgear_rattle.so, found from this test executable's
+/// path (target/<profile>/deps/…): the tests build in the `quick` profile, the FMU's binary in
+/// `release`.
 fn cdylib() -> PathBuf {
-    let lib = profile_dir().join("libgear_rattle.so");
+    let exe = std::env::current_exe().unwrap();
+    let target = exe.ancestors().nth(3).unwrap();
+    let lib = target.join("release/libgear_rattle.so");
     assert!(
         lib.exists(),
         "{} is missing: build it first with `cargo rustc --release -p gear_rattle --lib --crate-type cdylib` (make test does)",

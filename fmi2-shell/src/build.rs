@@ -127,8 +127,8 @@ struct Variable {
     /// Model Exchange: this variable is the time derivative of the continuous state named
     /// here; the order of these variables is the order of the state vector.
     derivative_of: Option<String>,
-    /// An Integer's values 0, 1, ... by name and description: an Enumeration in FMI 3.0
-    /// (FMI 2.0's description states them).
+    /// An Integer's values by name and description, numbered from its `min` (0 without
+    /// one): an Enumeration in FMI 3.0 (FMI 2.0's description states them).
     items: Option<Vec<(String, String)>>,
 }
 
@@ -167,6 +167,13 @@ impl Variable {
         } else {
             format!("{} (range: {statement})", self.description)
         }
+    }
+
+    /// The value of the first of the `items`: the `min`, else 0.
+    fn first_item(&self) -> i64 {
+        self.min
+            .as_ref()
+            .map_or(0, |m| m.as_integer().expect("an Integer's min"))
     }
 
     fn variability(&self) -> &'static str {
@@ -354,6 +361,15 @@ fn check(c: &Contract) {
                 "{}: start {x} outside its range {}",
                 v.name,
                 range.statement(&v.name)
+            );
+        }
+        if let Some(items) = &v.items {
+            let last = v.first_item() + items.len() as i64 - 1;
+            assert!(
+                v.ty == "Integer" && v.max.as_ref().is_none_or(|m| m.as_integer() == Some(last)),
+                "{}: items are an Integer's values {} to {last}, its min to its max",
+                v.name,
+                v.first_item()
             );
         }
         assert!(
@@ -557,6 +573,9 @@ fn log_categories_and_experiment(x: &mut String, c: &Contract) {
     *x += "/>\n";
 }
 
+/// Capabilities of the contract that FMI 3.0 alone has (FMI 2.0's description leaves them out).
+const FMI3_ONLY: [&str; 1] = ["hasEventMode"];
+
 fn xml(c: &Contract, guid: &str) -> String {
     let mut x = String::new();
     let m = &c.model;
@@ -581,7 +600,11 @@ fn xml(c: &Contract, guid: &str) -> String {
         x += "/>\n";
     }
     write!(x, "  <CoSimulation modelIdentifier=\"{}\"", m.identifier).unwrap();
-    for (k, v) in &c.capabilities {
+    for (k, v) in c
+        .capabilities
+        .iter()
+        .filter(|(k, _)| !FMI3_ONLY.contains(&k.as_str()))
+    {
         write!(x, " {k}=\"{}\"", value(v)).unwrap();
     }
     x += "/>\n";

@@ -23,11 +23,26 @@ pub struct Fmu<S> {
     /// fmi2LastSuccessfulTime: the end of the last step that succeeded (Co-Simulation), the
     /// time of the last completed integrator step (Model Exchange).
     last_successful_time: f64,
+    /// What the importer asked for at instantiation (FMI 3.0's Co-Simulation): kept by a
+    /// restored FMU state and by a reset, as the logging settings are.
+    #[serde(skip)]
+    pub events: CoSimulationEvents,
     pub slave: S,
     /// Start values other than the contract's (a packed model description's), applied at
     /// instantiation and at each reset; the instance's, not part of its FMU state.
     #[serde(skip)]
     starts: Starts,
+}
+
+/// FMI 3.0's Co-Simulation with events ([`Slave::STEPS_TO_EVENTS`]): what the importer allows
+/// at instantiation.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct CoSimulationEvents {
+    /// earlyReturnAllowed: a step may end at the model's first event inside it.
+    pub early_return_allowed: bool,
+    /// eventModeUsed: the importer enters event mode when a step ends at an event, and after
+    /// initialisation.
+    pub event_mode_used: bool,
 }
 
 impl<S: Slave> Fmu<S> {
@@ -37,6 +52,7 @@ impl<S: Slave> Fmu<S> {
             state: FmiState::Instantiated,
             time: 0.0,
             last_successful_time: 0.0,
+            events: CoSimulationEvents::default(),
             slave: S::new(logging_on, interface),
             starts: Starts::default(),
         }
@@ -88,6 +104,7 @@ impl<S: Slave> Fmu<S> {
         self.slave.exit_initialization_mode()?;
         self.last_successful_time = self.time;
         self.state = match self.interface() {
+            Interface::CoSimulation if self.events.event_mode_used => FmiState::EventMode,
             Interface::CoSimulation => FmiState::StepComplete,
             Interface::ModelExchange => FmiState::EventMode,
         };
@@ -131,12 +148,35 @@ impl<S: Slave> Fmu<S> {
     /// failed step leaves the instance in the error state at its time.
     #[inline]
     pub fn do_step(&mut self, current: f64, h: f64) -> FmiResult {
+        self.step_with(current, h, |s| s.step(current, h).map(|()| current + h))
+            .map(|_| ())
+    }
+
+    /// fmi3DoStep: as [`do_step`](Self::do_step), ended at the model's first event inside the
+    /// step where the importer allowed early return; returns the time reached (the instance's
+    /// time and last successful time).
+    pub fn do_step_to_event(&mut self, current: f64, h: f64) -> FmiResult<f64> {
+        match self.events.early_return_allowed {
+            true => self.step_with(current, h, |s| s.step_to_event(current, h)),
+            false => self.step_with(current, h, |s| s.step(current, h).map(|()| current + h)),
+        }
+    }
+
+    /// The step checked against the instance's time, then `step`, which gives the time it
+    /// reached; a failed step leaves the instance in the error state at its time.
+    #[inline]
+    fn step_with(
+        &mut self,
+        current: f64,
+        h: f64,
+        step: impl FnOnce(&mut S) -> FmiResult<f64>,
+    ) -> FmiResult<f64> {
         time::check_step(current, h, self.time)?;
-        match self.slave.step(current, h) {
-            Ok(()) => {
-                self.time = current + h;
+        match step(&mut self.slave) {
+            Ok(reached) => {
+                self.time = reached;
                 self.last_successful_time = self.time;
-                Ok(())
+                Ok(reached)
             }
             Err(e) => {
                 self.state = FmiState::Error;
@@ -195,10 +235,11 @@ impl<S: Slave> Fmu<S> {
     }
 
     fn take_over(&mut self, saved: &Self) {
-        let log = std::mem::take(self.log());
+        let (log, events) = (std::mem::take(self.log()), self.events);
         let starts = std::mem::take(&mut self.starts);
         *self = saved.clone();
         *self.log() = log;
+        self.events = events;
         self.starts = starts;
     }
 
@@ -219,9 +260,10 @@ impl<S: Slave> Fmu<S> {
                 self.time, self.last_successful_time
             )));
         }
+        // Event mode is both interfaces' (Co-Simulation's with eventModeUsed).
         let running = match self.state {
             FmiState::StepComplete => Some(Interface::CoSimulation),
-            FmiState::EventMode | FmiState::ContinuousTimeMode => Some(Interface::ModelExchange),
+            FmiState::ContinuousTimeMode => Some(Interface::ModelExchange),
             _ => None,
         };
         if let Some(interface) = running

@@ -46,7 +46,7 @@ pub mod vectors;
 
 #[cfg(feature = "runtime")]
 pub use fmi_sys::fmi2;
-pub use fmu::Fmu;
+pub use fmu::{CoSimulationEvents, Fmu};
 pub use log::{Log, Message};
 pub use slave::{EventInfo, Identity, Interface, Slave};
 pub use state::FmiState;

@@ -102,6 +102,18 @@ pub trait Slave: Clone + Serialize + DeserializeOwned {
     /// shell moves the instance into [`FmiState::Error`]; on success its time is `t + h`.
     fn step(&mut self, t: f64, h: f64) -> FmiResult;
 
+    /// Whether [`step_to_event`](Slave::step_to_event) may end a step early: the model's
+    /// events in Co-Simulation (FMI 3.0's early return and event mode, `hasEventMode` in its
+    /// model description).
+    const STEPS_TO_EVENTS: bool = false;
+
+    /// A step as [`step`](Slave::step), ended at the model's first event inside it where
+    /// [`STEPS_TO_EVENTS`](Slave::STEPS_TO_EVENTS) (FMI 3.0's early return); returns the time
+    /// reached, t + h if no event came first.
+    fn step_to_event(&mut self, t: f64, h: f64) -> FmiResult<f64> {
+        self.step(t, h).map(|()| t + h)
+    }
+
     /// Whether a slave decoded by fmi2DeSerializeFMUstate in `state` is one this build can
     /// run: the envelope's checksum catches corrupt bytes, not bytes made by hand with a
     /// valid one.

@@ -5,12 +5,14 @@
 #![allow(clippy::missing_safety_doc)]
 
 use fmi_sys::fmi3::*;
-use fmi2_shell::component::slice_mut;
+use fmi2_shell::component::{Component, slice_mut};
 use fmi2_shell::contract::fmi3::{EVENT_INDICATOR_VR, INTEGER_VR_OFFSET, TIME_VR};
 use fmi2_shell::contract::{Kind, unknown};
 use fmi2_shell::export::{check_token, create};
 use fmi2_shell::logger::Logger;
-use fmi2_shell::{EventInfo, FmiError, FmiResult, Fmu, Interface, Slave};
+use fmi2_shell::{
+    CoSimulationEvents, EventInfo, FmiError, FmiResult, FmiState, Fmu, Interface, Slave,
+};
 
 /// fmi3InstantiateModelExchange and fmi3InstantiateCoSimulation: an instance of the
 /// interface `wanted` if the token is this binary's (or a packed model description's beside
@@ -48,6 +50,80 @@ pub unsafe fn instantiate<S: Slave>(
             check,
             logging_on,
         )
+    }
+}
+
+/// fmi3InstantiateCoSimulation: an instance as [`instantiate`] makes it, with the events the
+/// importer allows (eventModeUsed refused for a model whose steps do not end at events).
+#[allow(clippy::too_many_arguments)] // FMI 3.0's arguments, as the exports receive them
+pub unsafe fn instantiate_co_simulation<S: Slave>(
+    instance_name: fmi3String,
+    token: fmi3String,
+    resource_path: fmi3String,
+    logging_on: bool,
+    event_mode_used: bool,
+    early_return_allowed: bool,
+    environment: fmi3InstanceEnvironment,
+    log_message: fmi3LogMessageCallback,
+) -> fmi3Instance {
+    let wanted = match event_mode_used && !S::STEPS_TO_EVENTS {
+        false => Ok(Interface::CoSimulation),
+        true => Err(
+            "eventModeUsed = true refused: hasEventMode is false (events are handled inside fmi3DoStep)",
+        ),
+    };
+    // SAFETY: the importer's arguments.
+    let instance = unsafe {
+        instantiate::<S>(
+            "fmi3InstantiateCoSimulation",
+            wanted,
+            instance_name,
+            token,
+            resource_path,
+            logging_on,
+            environment,
+            log_message,
+        )
+    };
+    // SAFETY: NULL, or the instance just made by fmi2-shell's `create`, a Component<S>.
+    if let Some(component) = unsafe { (instance as *mut Component<S>).as_mut() } {
+        component.fmu.events = CoSimulationEvents {
+            early_return_allowed,
+            event_mode_used,
+        };
+    }
+    instance
+}
+
+/// fmi3EnterEventMode: Model Exchange's, or Co-Simulation's where the importer set
+/// eventModeUsed.
+pub fn enter_event_mode<S: Slave>(fmu: &mut Fmu<S>) -> FmiResult {
+    if fmu.interface() == Interface::CoSimulation && !fmu.events.event_mode_used {
+        return Err(FmiError::error(
+            "fmi3EnterEventMode in Co-Simulation needs eventModeUsed = true at instantiation",
+        ));
+    }
+    fmu.enter_event_mode()
+}
+
+/// fmi3EnterStepMode: from Co-Simulation's event mode back to stepping.
+pub fn enter_step_mode<S: Slave>(fmu: &mut Fmu<S>) -> FmiResult {
+    if fmu.interface() != Interface::CoSimulation {
+        return Err(FmiError::error(
+            "fmi3EnterStepMode: a Model Exchange instance has no step mode",
+        ));
+    }
+    fmu.state = FmiState::StepComplete;
+    Ok(())
+}
+
+/// fmi3UpdateDiscreteStates: Model Exchange's event iteration; in Co-Simulation's event mode
+/// the step has handled the event already (an impact changes no discrete state the importer
+/// sets), so nothing is left to update.
+pub fn new_discrete_states<S: Slave>(fmu: &mut Fmu<S>) -> FmiResult<EventInfo> {
+    match fmu.interface() {
+        Interface::CoSimulation => Ok(EventInfo::default()),
+        Interface::ModelExchange => fmu.slave.new_discrete_states(),
     }
 }
 
@@ -168,8 +244,9 @@ pub unsafe fn answer<T>(out: *mut T, value: T) {
     }
 }
 
-/// fmi3DoStep: the step (never ended early, never asking for event handling or the end)
-/// and its last successful time.
+/// fmi3DoStep: the step, ended early at the model's first event inside it where the importer
+/// allowed it (event handling then needed if it uses event mode), and its last successful
+/// time; it never asks for the end of the simulation.
 pub unsafe fn do_step<S: Slave>(
     fmu: &mut Fmu<S>,
     current: f64,
@@ -179,15 +256,16 @@ pub unsafe fn do_step<S: Slave>(
     early_return: *mut bool,
     last_successful_time: *mut f64,
 ) -> FmiResult {
-    let done = fmu.do_step(current, h);
+    let done = fmu.do_step_to_event(current, h);
+    let early = done.as_ref().is_ok_and(|&reached| reached < current + h);
     // SAFETY: the importer's pointers.
     unsafe {
-        answer(event_handling_needed, false);
+        answer(event_handling_needed, early && fmu.events.event_mode_used);
         answer(terminate_simulation, false);
-        answer(early_return, false);
+        answer(early_return, early);
         answer(last_successful_time, fmu.last_successful_time());
     }
-    done
+    done.map(|_| ())
 }
 
 /// fmi3UpdateDiscreteStates's answers.

@@ -10,12 +10,14 @@
 //! - the arguments FMI 3.0 passes otherwise ([`export`]): one value-reference space
 //!   ([`fmi2_shell::contract::fmi3`]), the time and event indicators as variables,
 //!   Enumerations as Int64, the adjoint derivatives from the directional ones, the
-//!   instantiation of each interface;
+//!   instantiation of each interface, Co-Simulation's early return at the model's events
+//!   ([`Slave::step_to_event`]) and its event mode, as the importer allows them;
 //! - the exports themselves ([`export_fmi3!`]).
 //!
-//! Not offered: Co-Simulation's event mode and early return, clocks, scheduled execution,
-//! configuration mode (the model has no structural parameter); their functions refuse with
-//! a log line.
+//! Not offered: intermediate updates, clocks, scheduled execution, configuration mode (the
+//! model has no structural parameter); their functions refuse with a log line.
+//!
+//! [`Slave::step_to_event`]: fmi2_shell::Slave::step_to_event
 //!
 //! [`Slave`]: fmi2_shell::Slave
 //! [`Fmu`]: fmi2_shell::Fmu

@@ -44,8 +44,9 @@ macro_rules! __fmi3_exports {
                         instanceName, instantiationToken, resourcePath, loggingOn, instanceEnvironment, logMessage)
                 }
             }
-            // Early return is never taken (canReturnEarlyAfterIntermediateUpdate is false), so
-            // earlyReturnAllowed, the intermediate variables and their callback go unused.
+            // The model's own early return at its events (where it offers them) and event mode
+            // as the importer allows them; no intermediate update (its variables and callback
+            // go unused: canReturnEarlyAfterIntermediateUpdate is false).
             #[unsafe(no_mangle)]
             pub unsafe extern "C" fn fmi3InstantiateCoSimulation(
                 instanceName: fmi3String,
@@ -54,20 +55,16 @@ macro_rules! __fmi3_exports {
                 _visible: fmi3Boolean,
                 loggingOn: fmi3Boolean,
                 eventModeUsed: fmi3Boolean,
-                _earlyReturnAllowed: fmi3Boolean,
+                earlyReturnAllowed: fmi3Boolean,
                 _requiredIntermediateVariables: *const fmi3ValueReference,
                 _nRequiredIntermediateVariables: usize,
                 instanceEnvironment: fmi3InstanceEnvironment,
                 logMessage: fmi3LogMessageCallback,
                 _intermediateUpdate: fmi3IntermediateUpdateCallback,
             ) -> fmi3Instance {
-                let wanted = match eventModeUsed {
-                    false => Ok(Interface::CoSimulation),
-                    true => Err("eventModeUsed = true refused: hasEventMode is false (events are handled inside fmi3DoStep)"),
-                };
                 unsafe {
-                    e3::instantiate::<S>("fmi3InstantiateCoSimulation", wanted,
-                        instanceName, instantiationToken, resourcePath, loggingOn, instanceEnvironment, logMessage)
+                    e3::instantiate_co_simulation::<S>(instanceName, instantiationToken, resourcePath,
+                        loggingOn, eventModeUsed, earlyReturnAllowed, instanceEnvironment, logMessage)
                 }
             }
             /// Scheduled execution is not offered: no instance.
@@ -104,7 +101,7 @@ macro_rules! __fmi3_exports {
                     s.enter_initialization_mode()
                 };
             fn fmi3ExitInitializationMode() EXIT_INITIALIZATION_MODE |s| s.exit_initialization_mode();
-            fn fmi3EnterEventMode() ENTER_EVENT_MODE |s| s.enter_event_mode();
+            fn fmi3EnterEventMode() ENTER_EVENT_MODE |s| e3::enter_event_mode(s);
             fn fmi3Terminate() TERMINATE |s| s.terminate();
             fn fmi3Reset() RESET |s| s.reset();
 
@@ -263,7 +260,7 @@ macro_rules! __fmi3_exports {
                 valuesOfContinuousStatesChanged: *mut fmi3Boolean, nextEventTimeDefined: *mut fmi3Boolean,
                 nextEventTime: *mut fmi3Float64)
                 UPDATE_DISCRETE_STATES |s| {
-                    let info = s.slave.new_discrete_states()?;
+                    let info = e3::new_discrete_states(s)?;
                     unsafe {
                         e3::update_discrete_states(info, discreteStatesNeedUpdate, terminateSimulation,
                             nominalsOfContinuousStatesChanged, valuesOfContinuousStatesChanged,
@@ -299,7 +296,7 @@ macro_rules! __fmi3_exports {
                 |_| unsafe { e3::number(n, contract::STATES.len()) };
 
             // Co-Simulation.
-            fn fmi3EnterStepMode() NOT_OFFERED |_| Ok(());
+            fn fmi3EnterStepMode() ENTER_STEP_MODE |s| e3::enter_step_mode(s);
             fn fmi3GetOutputDerivatives(vr: *const fmi3ValueReference, nvr: usize, order: *const fmi3Int32,
                 value: *mut fmi3Float64, nValues: usize)
                 GET_OUTPUT_DERIVATIVES |s| {

@@ -1,9 +1,10 @@
 //! The FMI 3.0 state machine over fmi2-shell's states: for each function, in one table, the
 //! states in which it may be called (as the Reference-FMUs' masks). FMI 3.0's Step Mode is
-//! [`FmiState::StepComplete`](fmi2_shell::FmiState::StepComplete); Co-Simulation never enters
-//! event mode (hasEventMode is false), so Event Mode and Continuous-Time Mode are Model
-//! Exchange's. Configuration, clock activation and intermediate update modes are never
-//! entered: their functions have no state to be called in.
+//! [`FmiState::StepComplete`](fmi2_shell::FmiState::StepComplete); Event Mode is both
+//! interfaces' (Co-Simulation's where the importer set eventModeUsed, which the functions
+//! check), Continuous-Time Mode Model Exchange's. Configuration, clock activation and
+//! intermediate update modes are never entered: their functions have no state to be called
+//! in.
 
 pub mod allowed {
     /// The functions FMI 3.0 keeps, in the same states as FMI 2.0 (fmi3EnterInitializationMode
@@ -14,13 +15,13 @@ pub mod allowed {
         NEW_DISCRETE_STATES as UPDATE_DISCRETE_STATES, RESET, SET, SET_CONTINUOUS_STATES,
         SET_DEBUG_LOGGING, SET_TIME, TERMINATE,
     };
-    use fmi2_shell::state::{ANY, CONTINUOUS, ERROR, STEP_COMPLETE, TERMINATED};
-    /// Model Exchange only: Co-Simulation's event mode is not offered.
-    pub const ENTER_EVENT_MODE: u8 = CONTINUOUS;
+    use fmi2_shell::state::{ANY, CONTINUOUS, ERROR, EVENT, STEP_COMPLETE, TERMINATED};
+    /// From Model Exchange's continuous-time mode, or Co-Simulation's step mode.
+    pub const ENTER_EVENT_MODE: u8 = CONTINUOUS | STEP_COMPLETE;
+    /// fmi3EnterStepMode: from Co-Simulation's event mode.
+    pub const ENTER_STEP_MODE: u8 = EVENT;
     /// fmi3GetDirectionalDerivative, fmi3GetAdjointDerivative.
     pub const DERIVATIVES: u8 = GET & !ERROR;
-    /// fmi3EnterStepMode (Co-Simulation's event mode): never in a state to be called.
-    pub const NOT_OFFERED: u8 = 0;
     /// Without clocks there is nothing to evaluate, wherever the importer asks.
     pub const EVALUATE_DISCRETE_STATES: u8 = SET_TIME;
     /// The functions of clocks and configuration mode: admitted in every state, so that their
@@ -47,9 +48,9 @@ mod tests {
         };
         assert_eq!(admits(ENTER_INITIALIZATION_MODE), [Instantiated]);
         assert_eq!(admits(DO_STEP), [StepComplete]);
-        assert_eq!(admits(ENTER_EVENT_MODE), [ContinuousTimeMode]);
+        assert_eq!(admits(ENTER_EVENT_MODE), [StepComplete, ContinuousTimeMode]);
         assert_eq!(admits(UPDATE_DISCRETE_STATES), [EventMode]);
-        assert_eq!(admits(NOT_OFFERED), []);
+        assert_eq!(admits(ENTER_STEP_MODE), [EventMode]);
         assert_eq!(
             admits(SET),
             [

@@ -194,12 +194,12 @@ fn corrupt_or_inconsistent_states_are_refused() {
         assert!(refused.contains("checksum"), "{refused}");
         let stepping = serialize(&i);
         let mut me = deserialize::<Instance>(&stepping).unwrap();
-        me.state = FmiState::EventMode;
+        me.state = FmiState::ContinuousTimeMode;
         let refused = deserialize::<Instance>(&serialize(&me))
             .unwrap_err()
             .message;
         assert!(
-            refused.contains("CoSimulation instance in state EventMode"),
+            refused.contains("CoSimulation instance in state ContinuousTimeMode"),
             "{refused}"
         );
     });

@@ -25,12 +25,14 @@ pub fn gear_rattle() -> Model {
 
 /// GearboxRattle, with its documentation page.
 pub fn gearbox_rattle() -> Model {
-    use contracts::gearbox_rattle::{MODEL_DESCRIPTION_XML, MODEL_IDENTIFIER};
+    use contracts::gearbox_rattle::{
+        MODEL_DESCRIPTION_FMI3_XML, MODEL_DESCRIPTION_XML, MODEL_IDENTIFIER,
+    };
     Model {
         identifier: MODEL_IDENTIFIER,
         library: "gearbox_rattle",
         model_description: MODEL_DESCRIPTION_XML,
-        model_description_fmi3: None,
+        model_description_fmi3: Some(MODEL_DESCRIPTION_FMI3_XML),
         documentation: vec![(
             "index.html",
             gearbox_documentation::index_html().into_bytes(),

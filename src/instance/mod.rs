@@ -106,14 +106,16 @@ impl Instance {
     /// the main shaft's new motion (inputs mode) or torque (torque mode) to the running
     /// simulation (inputs take effect at once).
     fn inputs_changed(&mut self, state: FmiState) {
+        // Co-Simulation's event mode (FMI 3.0) sets inputs between steps, as step mode does.
+        let stepping = self.interface == Interface::CoSimulation;
         match state {
-            FmiState::EventMode | FmiState::ContinuousTimeMode => {
+            FmiState::EventMode | FmiState::ContinuousTimeMode if !stepping => {
                 let (shaft, tau, rate) = self.shaft_inputs();
                 let sim = self.sim.as_mut().expect("initialised");
                 sim.set_shaft_inputs(shaft);
                 sim.set_torque(tau, rate);
             }
-            FmiState::StepComplete => {
+            FmiState::StepComplete | FmiState::EventMode => {
                 let (shaft, tau, rate) = self.shaft_inputs();
                 let sim = self.sim.as_mut().expect("initialised");
                 let before = sim.impacts();
@@ -169,6 +171,43 @@ impl Instance {
             "Radau IIA"
         } else {
             "DOPRI5"
+        }
+    }
+
+    /// A communication step from the master's point `current` (the shell has checked it)
+    /// towards current + h, with `at_impact` ended at the first impact inside it; returns
+    /// the time reached. A failure leaves the state at `current`.
+    fn step_until(&mut self, current: f64, h: f64, at_impact: bool) -> FmiResult<f64> {
+        let sim = self.sim.as_mut().expect("initialised");
+        sim.t = current;
+        let t_end = current + h;
+        // What the event log compares with, taken only when that log is on.
+        let before = self
+            .log
+            .is_on(EVENTS)
+            .then(|| (sim.impacts(), sim.stats().switches));
+        // A state that overflowed (far out on the time axis, huge inputs) is a failed step.
+        let overflowed = |sim: &Simulation| {
+            let (xi, xi_dot) = (sim.real_output(vr::xi), sim.real_output(vr::xi_dot));
+            !(xi.is_some_and(f64::is_finite) && xi_dot.is_some_and(f64::is_finite))
+        };
+        match sim.step_until(t_end, at_impact) {
+            Ok(_) if overflowed(sim) => Err(FmiError::error(format!(
+                "fmi2DoStep from t = {current} to {t_end} failed: the state is no longer finite (times, steps or inputs beyond what the model can represent); fmi2Reset to start over"
+            ))),
+            Ok(reached) => {
+                self.sync_inputs();
+                if let Some(before) = before {
+                    self.log_events(reached, before);
+                }
+                if self.log.is_on(STEPS) {
+                    self.log_steps(reached);
+                }
+                Ok(reached)
+            }
+            Err(e) => Err(FmiError::error(format!(
+                "fmi2DoStep from t = {current} to {t_end} failed: {e}; the state stays at t = {current}"
+            ))),
         }
     }
 
@@ -380,37 +419,14 @@ impl Slave for Instance {
     /// One communication step from the master's point `current` (the shell has checked it
     /// against the time); a failure leaves the state at `current`.
     fn step(&mut self, current: f64, h: f64) -> FmiResult {
-        let sim = self.sim.as_mut().expect("initialised");
-        sim.t = current;
-        let t_end = current + h;
-        // What the event log compares with, taken only when that log is on.
-        let before = self
-            .log
-            .is_on(EVENTS)
-            .then(|| (sim.impacts(), sim.stats().switches));
-        // A state that overflowed (far out on the time axis, huge inputs) is a failed step.
-        let overflowed = |sim: &Simulation| {
-            let (xi, xi_dot) = (sim.real_output(vr::xi), sim.real_output(vr::xi_dot));
-            !(xi.is_some_and(f64::is_finite) && xi_dot.is_some_and(f64::is_finite))
-        };
-        match sim.step_to(t_end) {
-            Ok(()) if overflowed(sim) => Err(FmiError::error(format!(
-                "fmi2DoStep from t = {current} to {t_end} failed: the state is no longer finite (times, steps or inputs beyond what the model can represent); fmi2Reset to start over"
-            ))),
-            Ok(()) => {
-                self.sync_inputs();
-                if let Some(before) = before {
-                    self.log_events(t_end, before);
-                }
-                if self.log.is_on(STEPS) {
-                    self.log_steps(t_end);
-                }
-                Ok(())
-            }
-            Err(e) => Err(FmiError::error(format!(
-                "fmi2DoStep from t = {current} to {t_end} failed: {e}; the state stays at t = {current}"
-            ))),
-        }
+        self.step_until(current, h, false).map(|_| ())
+    }
+
+    /// Early return (FMI 3.0): the step ends at the first impact inside it.
+    const STEPS_TO_EVENTS: bool = true;
+
+    fn step_to_event(&mut self, current: f64, h: f64) -> FmiResult<f64> {
+        self.step_until(current, h, true)
     }
 
     /// fmi2SetRealInputDerivatives: the derivatives of θ_M (orders 1, 2) and ω_M (order 1) at

@@ -52,11 +52,24 @@ impl<S: Piecewise<N> + Jacobian<N> + Copy, const N: usize> Stepped<S, N> {
     /// call served from the solver's kept step cannot fail and needs no copy to roll back to
     /// (at 10 µs communication steps most are).
     pub fn advance_to(&mut self, t: &mut f64, t_end: f64) -> Result<(), SolverError> {
+        self.advance_until(t, t_end, |_| 0).map(|_| ())
+    }
+
+    /// [`advance_to`](Self::advance_to), stopping on the first edge crossed that raises the
+    /// system's count of `events` ([`Solver::advance_until`]): true if it stopped there.
+    pub fn advance_until(
+        &mut self,
+        t: &mut f64,
+        t_end: f64,
+        events: impl Fn(&S) -> u64,
+    ) -> Result<bool, SolverError> {
         if self.solver.serve(&mut self.system, t, &mut self.y, t_end) {
-            return Ok(());
+            return Ok(false);
         }
         let (before, t_before) = (*self, *t);
-        let advanced = self.solver.advance(&mut self.system, t, &mut self.y, t_end);
+        let advanced = self
+            .solver
+            .advance_until(&mut self.system, t, &mut self.y, t_end, events);
         if advanced.is_err() {
             (*self, *t) = (before, t_before);
         }
@@ -67,16 +80,27 @@ impl<S: Piecewise<N> + Jacobian<N> + Copy, const N: usize> Stepped<S, N> {
 impl<S: GearPair<N> + Jacobian<N> + Copy, const N: usize> Stepped<S, N> {
     /// Advances to t_end, through the opening of the statistics window on the way, where its
     /// quadratures are kept; on failure the pair, its solver and t are left as they were.
-    fn advance(&mut self, t: &mut f64, t_end: f64) -> Result<(), SolverError> {
+    /// With `at_impact`, stops at the first impact (contact onset) on the way, as located:
+    /// true if it did.
+    fn advance(&mut self, t: &mut f64, t_end: f64, at_impact: bool) -> Result<bool, SolverError> {
+        let impacts = move |s: &S| {
+            let count = s.impacts().count;
+            if at_impact { count[0] + count[1] } else { 0 }
+        };
         let window = self.system.window();
         if window.is_opened() || window.from > t_end {
-            return self.advance_to(t, t_end);
+            return self.advance_until(t, t_end, impacts);
         }
         let (before, t_before) = (*self, *t);
-        let advanced = self.advance_to(t, window.from).and_then(|()| {
-            self.open_window();
-            self.advance_to(t, t_end)
-        });
+        let advanced = self
+            .advance_until(t, window.from, impacts)
+            .and_then(|stopped| {
+                if stopped {
+                    return Ok(true);
+                }
+                self.open_window();
+                self.advance_until(t, t_end, impacts)
+            });
         if advanced.is_err() {
             (*self, *t) = (before, t_before);
         }
@@ -420,17 +444,27 @@ impl Simulation {
 
     /// Advances to t_end. On failure the simulation is left as it was.
     pub fn step_to(&mut self, t_end: f64) -> Result<(), SolverError> {
-        on_gear!(&mut self.gear, k => k.advance(&mut self.t, t_end)?);
-        self.t = t_end;
+        self.step_until(t_end, false).map(|_| ())
+    }
+
+    /// Advances to t_end, or with `at_impact` to the first impact before it (its instant as
+    /// the integrator locates it); returns the time reached. On failure the simulation is
+    /// left as it was.
+    pub fn step_until(&mut self, t_end: f64, at_impact: bool) -> Result<f64, SolverError> {
+        let stopped = on_gear!(&mut self.gear, k => k.advance(&mut self.t, t_end, at_impact)?);
+        if !stopped {
+            self.t = t_end;
+        }
+        let t = self.t;
         // The inputs continue along their extrapolation unless the master sets new ones.
         match &mut self.drive {
             Drive::Inputs(shaft) => by_coupling!(&self.gear,
-                kinematic k => *shaft = k.system.excitation.at(t_end), torque _ => {}),
+                kinematic k => *shaft = k.system.excitation.at(t), torque _ => {}),
             Drive::Torque { tau, .. } => by_coupling!(&self.gear,
-                kinematic _ => {}, torque k => *tau = k.system.torque.at(t_end)),
+                kinematic _ => {}, torque k => *tau = k.system.torque.at(t)),
             Drive::Sine(_) => {}
         }
-        Ok(())
+        Ok(t)
     }
 
     /// The value of a Real output, computed now; None if `vr` is not a Real output.

@@ -200,21 +200,48 @@ impl<const N: usize> Solver<N> {
         y: &mut [f64; N],
         t_end: f64,
     ) -> Result<(), SolverError> {
+        self.advance_until(sys, t, y, t_end, |_| 0).map(|_| ())
+    }
+
+    /// Advances (t, y) towards `t_end` as [`advance`](Self::advance) does, and stops on the
+    /// first edge whose crossing raises the system's count of `events` (a gear pair's
+    /// impacts): true if it stopped there, (t, y) at the edge as located, false at t_end. Up
+    /// to the stop the trajectory is `advance`'s, to the bit; the next call continues from
+    /// the edge, just crossed.
+    pub fn advance_until<S: Piecewise<N> + Jacobian<N>>(
+        &mut self,
+        sys: &mut S,
+        t: &mut f64,
+        y: &mut [f64; N],
+        t_end: f64,
+        events: impl Fn(&S) -> u64,
+    ) -> Result<bool, SolverError> {
         if self.serve(sys, t, y, t_end) {
-            return Ok(());
+            return Ok(false);
         }
+        let mut seen = events(sys);
         self.resume(sys, t, y);
+        if events(sys) != seen {
+            return Ok(true);
+        }
+        let t_start = *t;
         let mut call = Call::new(t_end);
         // The series are written here in place, the DOPRI5 steps in `call.trial`.
         let mut series = [[0.0; N]; taylor::TERMS];
         while *t < t_end {
             if !self.just_crossed && sys.settle(*t, y) > 0 {
                 self.invalidate();
+                // Edges crossed where the call starts (the state moved from outside) are no
+                // event to stop at.
+                if *t == t_start {
+                    seen = events(sys);
+                }
             }
             if let Some(flow) = self.pass(sys, t, y, t_end)? {
                 match flow {
+                    Flow::Go if events(sys) != seen => return Ok(true),
                     Flow::Go => continue,
-                    Flow::Done => return Ok(()),
+                    Flow::Done => return Ok(false),
                 }
             }
             call.past = self.interpolate_ends && self.rk.mode == Mode::Dopri5;
@@ -239,10 +266,13 @@ impl<const N: usize> Solver<N> {
                 }
             };
             if self.end_step(sys, &step, t, y, &mut call)? == Flow::Done {
-                return Ok(());
+                return Ok(false);
+            }
+            if events(sys) != seen {
+                return Ok(true);
             }
         }
-        Ok(())
+        Ok(false)
     }
 
     /// At the start of a call: from the end of the step kept by the last one if the call

@@ -218,3 +218,37 @@ fn a_restored_solver_continues_bit_for_bit() {
         (sb.accepted, sb.rejected, sb.rhs_evals)
     );
 }
+
+/// `advance_until` stops on each edge whose crossing changes the count it is given (here the
+/// contact itself: every landing and lift-off of the undamped bounce), with the state on the
+/// edge: the first landing of the fall from 0.05 m where it falls, at 0.1 s. A call that
+/// continues from a stop to the same end time goes on as `advance` does: the end times get
+/// the states of a run that never stopped, to the bit.
+#[test]
+fn advance_until_stops_on_each_edge_and_keeps_the_trajectory() {
+    let y0 = [0.05, 0.0];
+    let ends: Vec<f64> = (0..=40).map(|k| k as f64 * 0.0123).collect();
+    let mut plain = Solver::new(bounce_tolerance());
+    let want = run(&mut Bounce::new(0.0, y0[0]), &mut plain, &ends, y0);
+    let mut sys = Bounce::new(0.0, y0[0]);
+    let mut solver = Solver::new(bounce_tolerance());
+    let (mut t, mut y, mut stops, mut got) = (0.0, y0, Vec::new(), Vec::new());
+    for &t_end in &ends[1..] {
+        let contact = |s: &Bounce| u64::from(s.contact);
+        while solver
+            .advance_until(&mut sys, &mut t, &mut y, t_end, contact)
+            .unwrap()
+        {
+            assert!(t < t_end && y[0].abs() < 1e-12, "{t} {y:?}");
+            stops.push(t);
+        }
+        assert_eq!(t, t_end);
+        got.push(y);
+    }
+    assert_eq!(got, want);
+    assert_eq!(stops.len() as u64, plain.stats.edges);
+    assert!(
+        stops.len() >= 4 && (stops[0] - 0.1).abs() < 1e-12,
+        "{stops:?}"
+    );
+}

@@ -2,7 +2,8 @@
 against the FMI 2.0 one: the same trajectories to the bit in co-simulation, within the
 tolerance in Model Exchange; FMPy's validation and the FMI 3.0 schema; the low-level API
 (FMU state, serialization, directional and adjoint derivatives, event indicators as
-variables); FMI 3.0's state machine refusing what is not offered, with a log line."""
+variables, early return at each impact against the reference's instants, Co-Simulation's
+event mode); FMI 3.0's state machine refusing what is not offered, with a log line."""
 
 import ctypes
 import zipfile
@@ -13,6 +14,8 @@ from fmpy import extract, read_model_description, simulate_fmu
 from fmpy.fmi1 import FMICallException
 from fmpy.fmi3 import FMU3Model, FMU3Slave
 from support.fmu import FMU3_PATH, FMU_PATH, OUTPUTS, main_shaft_input
+
+from gearrattle import reference as R
 
 G = 25e-6
 
@@ -45,6 +48,7 @@ def test_validates_and_declares_fmi3s_types(fmu3_path, md3):
 
     assert validate_fmu(fmu3_path) == []
     assert md3.fmiVersion == "3.0" and md3.modelExchange and md3.coSimulation
+    assert md3.coSimulation.hasEventMode and not md3.coSimulation.canReturnEarlyAfterIntermediateUpdate
     types = {v.name: v.type for v in md3.modelVariables}
     for name in ("excitation", "solver", "contact", "stat_regime"):
         assert types[name] == "Enumeration", name
@@ -103,11 +107,13 @@ def slave3(md3, unzipdir3, name, messages=None, **kw):
     return fmu
 
 
-def started(md3, unzipdir3, name, messages=None):
-    """A co-simulation instance on the paper's bench sine (the Enumeration set through Int64)."""
-    fmu = slave3(md3, unzipdir3, name, messages)
+def started(md3, unzipdir3, name, messages=None, **kw):
+    """A co-simulation instance on the paper's bench sine (the Enumeration set through Int64),
+    scene S1; kw to fmi3InstantiateCoSimulation."""
+    fmu = slave3(md3, unzipdir3, name, messages, **kw)
     fmu.enterInitializationMode(startTime=0.0)
     fmu.setInt64([vr_of(md3, "excitation")], [1])
+    fmu.setFloat64([vr_of(md3, "f_exc"), vr_of(md3, "A_rms")], [R.SCENES["S1"]["f_exc"], R.SCENES["S1"]["A_rms"]])
     fmu.exitInitializationMode()
     return fmu
 
@@ -165,14 +171,95 @@ def test_directional_and_adjoint_derivatives_in_model_exchange(md3, unzipdir3):
     fmu.freeInstance()
 
 
+EARLY_T_END, EARLY_H = 0.1, 1e-3
+
+
+def stepped_to_impacts(md3, unzipdir3, event_mode):
+    """S1 over EARLY_T_END in communication steps of EARLY_H with early return allowed, each
+    early return followed by a step from where it stopped to the same communication point:
+    the times returned early, the state there (xi, impacts_Fplus + impacts_Fminus, read in
+    event mode if `event_mode`), the impact count at the end and xi, xi' at every
+    communication point."""
+    fmu = started(md3, unzipdir3, "early", earlyReturnAllowed=True, eventModeUsed=event_mode)
+    counts = [vr_of(md3, "impacts_Fplus"), vr_of(md3, "impacts_Fminus")]
+    xi = [vr_of(md3, "xi"), vr_of(md3, "xi_dot")]
+    if event_mode:
+        # eventModeUsed: initialisation ends in event mode.
+        assert fmu.updateDiscreteStates()[0] is False
+        fmu.enterStepMode()
+    t, k, returned, at_return, grid = 0.0, 1, [], [], []
+    while k <= round(EARLY_T_END / EARLY_H):
+        event, terminate, early, last = fmu.doStep(t, k * EARLY_H - t)
+        assert (event, terminate) == (early and event_mode, False)
+        if early:
+            assert t < last < k * EARLY_H
+            if event_mode:
+                fmu.enterEventMode()
+            returned.append(last)
+            at_return.append((fmu.getFloat64(xi[:1])[0], sum(fmu.getInt32(counts))))
+            if event_mode:
+                fmu.updateDiscreteStates()
+                fmu.enterStepMode()
+        else:
+            assert last == k * EARLY_H
+            grid.append(fmu.getFloat64(xi))
+            k += 1
+        t = last
+    total = sum(fmu.getInt32(counts))
+    fmu.terminate()
+    fmu.freeInstance()
+    return np.array(returned), at_return, total, np.array(grid)
+
+
+@pytest.mark.parametrize("event_mode", [False, True], ids=["early return", "event mode"])
+def test_early_return_at_each_impact(md3, unzipdir3, event_mode):
+    """One early return per impact, at the reference's instants within the FMI 2.0 sine tests'
+    1e-7 s, the state there on the contact edge (xi = 0 or G) as the integrator locates it,
+    the impact counted by then; the trajectory at the communication points that of a master
+    that does not allow early return, to the bit."""
+    returned, at_return, total, grid = stepped_to_impacts(md3, unzipdir3, event_mode)
+    ref = R.scene("S1", EARLY_T_END)
+    assert total > 10 and len(returned) == total == ref.impact_t.size
+    assert np.max(np.abs(returned - ref.impact_t)) < 1e-7
+    assert [n for _, n in at_return] == list(range(1, total + 1))
+    assert max(min(abs(x), abs(x - G)) for x, _ in at_return) < 1e-9 * G
+    fmu = started(md3, unzipdir3, "no early return")
+    plain = []
+    for k in range(1, round(EARLY_T_END / EARLY_H) + 1):
+        assert fmu.doStep((k - 1) * EARLY_H, EARLY_H * k - (k - 1) * EARLY_H)[2:] == (False, k * EARLY_H)
+        plain.append(fmu.getFloat64([vr_of(md3, "xi"), vr_of(md3, "xi_dot")]))
+    fmu.freeInstance()
+    np.testing.assert_array_equal(grid, np.array(plain))
+
+
+def test_inputs_set_in_event_mode_as_in_step_mode(md3, unzipdir3):
+    """Inputs mode: the main shaft's motion set in Co-Simulation's event mode moves the pair
+    as the same values set in step mode do."""
+    shaft = [vr_of(md3, n) for n in ("theta_M", "omega_M", "alpha_M")]
+    xi = [vr_of(md3, "xi"), vr_of(md3, "xi_dot")]
+    runs = []
+    for event_mode in (False, True):
+        fmu = slave3(md3, unzipdir3, "inputs", eventModeUsed=event_mode)
+        fmu.enterInitializationMode(startTime=0.0)
+        fmu.exitInitializationMode()
+        if event_mode:
+            fmu.updateDiscreteStates()
+            fmu.enterStepMode()
+        fmu.doStep(0.0, 1e-3)
+        if event_mode:
+            fmu.enterEventMode()
+        fmu.setFloat64(shaft, [0.05, 80.0, 2e3])
+        if event_mode:
+            fmu.updateDiscreteStates()
+            fmu.enterStepMode()
+        runs.append(fmu.getFloat64(xi) + [fmu.doStep(1e-3, 1e-3)[3]] + fmu.getFloat64(xi))
+        fmu.freeInstance()
+    assert runs[0] == runs[1]
+
+
 def test_misuse_of_the_state_machine_is_refused_with_a_log_line(md3, unzipdir3):
     messages = []
-    # Co-Simulation's event mode is not offered.
-    with pytest.raises(Exception, match="Failed to instantiate"):
-        slave3(md3, unzipdir3, "event mode", messages, eventModeUsed=True)
-    assert any("hasEventMode is false" in m for m in messages)
     # A token from another build.
-    messages.clear()
     with pytest.raises(Exception, match="Failed to instantiate"):
         FMU3Slave(guid="{not this one}", unzipDirectory=unzipdir3, modelIdentifier="GearRattle",
                   instanceName="token").instantiate(logMessage=lambda e, s, c, m: messages.append(m.decode()))
@@ -186,7 +273,7 @@ def test_misuse_of_the_state_machine_is_refused_with_a_log_line(md3, unzipdir3):
     fmu.exitInitializationMode()
     for call, text in [(fmu.enterConfigurationMode, "structural parameters are not offered"),
                        (lambda: fmu.getClock([0]), "clocks are not offered"),
-                       (fmu.enterEventMode, "illegal call sequence: fmi3EnterEventMode"),
+                       (fmu.enterEventMode, "needs eventModeUsed = true at instantiation"),
                        (fmu.enterStepMode, "illegal call sequence: fmi3EnterStepMode")]:
         messages.clear()
         with pytest.raises(FMICallException):

@@ -1,7 +1,8 @@
 //! The FMI 3.0 model description of a contract, beside FMI 2.0's ([`super::xml`]): the same
 //! variables, units and capabilities in FMI 3.0's terms.
 //!   - Types: Real is Float64; Integer is Int32, or an Enumeration where the contract lists
-//!     its `items` (declared under TypeDefinitions, named as the variable).
+//!     its `items` (declared under TypeDefinitions, named as the variable, an array's
+//!     variable by its declared name: one type for `gear[1].contact` .. `gear[8].contact`).
 //!   - Value references: one space for all variables ([`crate::contract::fmi3`]); the
 //!     independent variable `time` and Model Exchange's event indicators (Float64 locals
 //!     `event_indicator_k`) are declared beside the contract's.
@@ -10,7 +11,8 @@
 //!   - Capabilities renamed where FMI 3.0 renamed them, dropped where it has none (and
 //!     canInterpolateInputs: FMI 3.0 has no fmi3SetInputDerivatives), and the adjoint
 //!     derivatives wherever the directional ones are offered (fmi3-shell computes them from
-//!     those). Co-Simulation declares no event mode and no early return.
+//!     those). Co-Simulation's `hasEventMode` is the contract's (FMI 3.0 only; absent:
+//!     false); no early return after an intermediate update (there is none).
 
 use super::{
     Contract, Variable, attributes, esc, initial_unknowns, log_categories_and_experiment, units,
@@ -43,6 +45,11 @@ fn type_name(v: &Variable) -> &'static str {
     }
 }
 
+/// The name of an Enumeration variable's type: the variable's name as the contract declares it.
+fn enumeration_type(v: &Variable) -> String {
+    esc(v.element.as_ref().map_or(&v.name, |e| &e.declared))
+}
+
 /// The FMI 3.0 name and value of a capability of the contract (FMI 2.0's names), if FMI 3.0
 /// has it.
 fn capability(name: &str, v: &toml::Value) -> Option<(&'static str, String)> {
@@ -54,6 +61,7 @@ fn capability(name: &str, v: &toml::Value) -> Option<(&'static str, String)> {
         "maxOutputDerivativeOrder" => "maxOutputDerivativeOrder",
         "canBeInstantiatedOnlyOncePerProcess" => "canBeInstantiatedOnlyOncePerProcess",
         "needsExecutionTool" => "needsExecutionTool",
+        "hasEventMode" => "hasEventMode",
         "completedIntegratorStepNotNeeded" => {
             let needed = !v.as_bool().expect("a boolean");
             return Some(("needsCompletedIntegratorStep", needed.to_string()));
@@ -112,18 +120,20 @@ pub(super) fn xml(c: &Contract, token: &str) -> String {
         "CoSimulation",
         &m.identifier,
         &c.capabilities,
-        &[
-            ("hasEventMode", "false"),
-            ("canReturnEarlyAfterIntermediateUpdate", "false"),
-        ],
+        &[("canReturnEarlyAfterIntermediateUpdate", "false")],
     );
     units(&mut x, c);
-    let enumerations: Vec<&Variable> = c.variable.iter().filter(|v| v.items.is_some()).collect();
+    let mut declared = std::collections::BTreeSet::new();
+    let enumerations: Vec<&Variable> = c
+        .variable
+        .iter()
+        .filter(|v| v.items.is_some() && declared.insert(enumeration_type(v)))
+        .collect();
     if !enumerations.is_empty() {
         x += "  <TypeDefinitions>\n";
         for v in &enumerations {
-            writeln!(x, "    <EnumerationType name=\"{}\">", esc(&v.name)).unwrap();
-            for (k, (name, description)) in v.items.iter().flatten().enumerate() {
+            writeln!(x, "    <EnumerationType name=\"{}\">", enumeration_type(v)).unwrap();
+            for (k, (name, description)) in (v.first_item()..).zip(v.items.iter().flatten()) {
                 writeln!(
                     x,
                     "      <Item name=\"{}\" value=\"{k}\" description=\"{}\"/>",
@@ -145,7 +155,7 @@ pub(super) fn xml(c: &Contract, token: &str) -> String {
     .unwrap();
     for v in &c.variable {
         variable_head(&mut x, type_name(v), v, vr(v));
-        if let Some(name) = v.items.as_ref().map(|_| esc(&v.name)) {
+        if let Some(name) = v.items.as_ref().map(|_| enumeration_type(v)) {
             write!(x, " declaredType=\"{name}\"").unwrap();
         }
         // An enumeration's range is its items.
