@@ -3,10 +3,9 @@
 //! GUID (FMI 3.0: instantiationToken) is not the built-in one, instantiation reads the model
 //! description beside the resources (FMI 2.0's fmuResourceLocation, a file URI, or FMI 3.0's
 //! resourcePath, a directory), or its copy inside them, and takes it if it names that GUID,
-//! this binary's model
-//! identifier and the contract's variables (names, value references, types, causalities, in
-//! the contract's order); its parameters' start values then pass the checks of fmi2Set* and
-//! the contract's ranges and become the instance's start values.
+//! this binary's model identifier and the contract's variables (names, value references,
+//! types, causalities, in the contract's order); its parameters' start values then pass the
+//! checks of fmi2Set* and the contract's ranges and become the instance's start values.
 
 use crate::contract::fmi3::{INTEGER_VR_OFFSET, TIME_VR};
 use crate::contract::{Causality, Kind, Variable, check_parameter};
