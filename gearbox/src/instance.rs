@@ -177,6 +177,7 @@ impl Slave for Instance {
         state_version: 1,
         model_exchange: true,
         variable: contract::variable,
+        variables: contract::VARIABLES,
     };
 
     fn new(logging_on: bool, interface: Interface) -> Self {
