@@ -15,8 +15,9 @@ FMU3_MODELS := GearRattle GearboxRattle
 LIB := target/release/libgear_rattle.so
 # The FMUs `make fmu` builds, by model identifier, and the crate of each one's binary.
 MODELS := GearRattle GearboxRattle
-crate_GearRattle := gear_rattle
-crate_GearboxRattle := gearbox_rattle
+crate_GearRattle := gear_rattle_fmu
+crate_GearboxRattle := gearbox_rattle_fmu
+CRATES := $(foreach m,$(MODELS),$(crate_$(m)))
 # The FMU's binaries as built (with line tables, for debugging) and as packaged (stripped).
 FMU_DEBUG := target/fmu/debug
 FMU_STRIPPED := target/fmu/stripped
@@ -89,14 +90,11 @@ demo: $(VENV)/.demo-installed $(HOST_FMU)/GearRattle.fmu
 test: $(TEST_TARGETS)
 
 # The C-API tests load the FMU's linux64 binary as cargo-zigbuild builds it (mk/portable.mk):
-# the library shipped, and no second release build of it. fmi2-shell's
-# own tests check FMI's rules on a model of their own, fmi3-shell's its state table. The
-# gearbox's crate is tested on its own: built with gear_rattle in one cargo call, gear_rattle's
-# `fmu` feature (its exports) would be on for the gearbox too, whose own would clash with them.
-CAPI_LIB = $(call linux_so,gear_rattle)
+# the library shipped, and no second release build of it. fmi2-shell's own tests check FMI's
+# rules on a model of their own, fmi3-shell's its state table.
+CAPI_LIB = $(call linux_so,$(crate_GearRattle))
 test-rust: $(CAPI_LIB) | libclang
-	GEAR_RATTLE_CDYLIB=$(abspath $(CAPI_LIB)) $(CARGO_TEST) -p gear_rattle -p fmi2-shell -p fmi3-shell
-	$(CARGO_TEST) -p gearbox_rattle
+	GEAR_RATTLE_CDYLIB=$(abspath $(CAPI_LIB)) $(CARGO_TEST) -p gear_rattle -p gearbox_rattle -p fmi2-shell -p fmi3-shell
 
 test-python: fmu $(VENV)/.installed
 	$(PY) -m pytest -q

@@ -19,9 +19,10 @@ TEST_TARGETS += test-portable
 
 .PHONY: zig-toolchain llvm-tools test-portable
 
-# Each binary is built as a cdylib alone (`cargo rustc --crate-type cdylib`): with the rlib
-# crate type of Cargo.toml beside it, LTO keeps every Rust function public and the linkers
-# keep much of them (win64 four times larger: docs/DECISIONS.md D23).
+# The FMUs' crates (fmus/) are cdylibs alone: with an rlib crate type beside, LTO keeps every
+# Rust function public and the linkers keep much of them (win64 four times larger:
+# docs/DECISIONS.md D23). One cargo call builds all of them for the three zig platforms, so
+# that their whole-program LTO links, single-threaded each, run side by side.
 # cargo-zigbuild runs from target/: zig prints its include directories relative to the working
 # directory when they lie below it (the .venv does), and cargo-zigbuild hands them as they are to
 # bindgen (fmi-sys), which runs elsewhere and then finds no stddef.h. cargo still reads
@@ -29,20 +30,19 @@ TEST_TARGETS += test-portable
 # minimum macOS (zig's default is its newest).
 ZIGBUILD = mkdir -p target && cd target && \
 	CARGO_ZIGBUILD_PYTHON_PATH=$(CURDIR)/$(PY) MACOSX_DEPLOYMENT_TARGET=11.0 \
-	$(CURDIR)/$(VENV)/bin/cargo-zigbuild rustc --manifest-path $(CURDIR)/Cargo.toml --release --lib --crate-type cdylib
+	$(CURDIR)/$(VENV)/bin/cargo-zigbuild build --manifest-path $(CURDIR)/Cargo.toml --release --lib
 
-# The rules of one model $(1) whose crate is $(2). cargo decides what to rebuild; the rules
-# of its binaries always ask it. zig's Mach-O linker ignores rustc's exported-symbols list:
-# mk/darwin-link.py, set as the linker here, keeps the exports to fmi2* (cargo's --config
-# wins over cargo-zigbuild's setting). The unstripped copy of each binary that goes into the
-# FMU (the two darwin slices joined into one universal dylib), then the stripped one (below).
+# zig's Mach-O linker ignores rustc's exported-symbols list: mk/darwin-link.py, set as the
+# linker here, keeps the exports to fmi2* and fmi3* (cargo's --config wins over
+# cargo-zigbuild's setting). cargo decides what to rebuild; the rule always asks it.
+ZIG_LIBS := $(foreach c,$(CRATES),$(call linux_so,$(c)) $(call darwin_slices,$(c)))
+$(ZIG_LIBS) &: FORCE | libclang zig-toolchain
+	$(ZIGBUILD) $(addprefix -p ,$(CRATES)) --target $(LINUX_TARGET) \
+		$(foreach a,$(DARWIN_ARCHS),--target $(a)-apple-darwin --config 'target.$(a)-apple-darwin.linker="$(CURDIR)/mk/darwin-link.py"')
+
+# The unstripped copy of each binary of model $(1), crate $(2), that goes into the FMU (the two
+# darwin slices joined into one universal dylib), then the stripped one (below).
 define portable_rules
-$(call linux_so,$(2)): FORCE | libclang zig-toolchain
-	$$(ZIGBUILD) -p $(2) --target $(LINUX_TARGET)
-
-target/%-apple-darwin/release/lib$(2).dylib: FORCE | libclang zig-toolchain
-	$$(ZIGBUILD) -p $(2) --target $$*-apple-darwin --config 'target.$$*-apple-darwin.linker="$(CURDIR)/mk/darwin-link.py"'
-
 $(FMU_DEBUG)/linux64/$(1).so: $(call linux_so,$(2))
 
 $(FMU_DEBUG)/darwin64/$(1).dylib: $(call darwin_slices,$(2)) | llvm-tools

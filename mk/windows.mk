@@ -15,20 +15,18 @@ TEST_TARGETS += test-windows
 .PHONY: windows-toolchain windows-wine test-windows
 
 # fmi-sys's bindgen parses the FMI headers for the Windows target against MinGW's headers,
-# whose malloc.h needs clang's own include directory (mm_malloc.h) first. Built as a cdylib
-# alone, like the portable binaries (see mk/portable.mk). The rules of model $(1), crate $(2).
-define windows_rules
-$(call win_dll,$(2)): FORCE | libclang windows-toolchain
-	@mm_malloc=$$$$(ls /usr/lib/llvm-*/lib/clang/*/include/mm_malloc.h 2>/dev/null | sort -V | tail -n 1); \
-	[ -n "$$$$mm_malloc" ] || { echo "clang's mm_malloc.h not found (libclang-dev installs it)"; exit 1; }; \
-	export BINDGEN_EXTRA_CLANG_ARGS_x86_64_pc_windows_gnu="-I$$$$(dirname "$$$$mm_malloc")"; \
-	echo "BINDGEN_EXTRA_CLANG_ARGS_x86_64_pc_windows_gnu=$$$$BINDGEN_EXTRA_CLANG_ARGS_x86_64_pc_windows_gnu"; \
-	echo "cargo rustc --release -p $(2) --lib --crate-type cdylib --target $(WIN_TARGET)"; \
-	cargo rustc --release -p $(2) --lib --crate-type cdylib --target $(WIN_TARGET)
+# whose malloc.h needs clang's own include directory (mm_malloc.h) first. One cargo call builds
+# every FMU's crate (cdylibs alone, like the portable binaries: see mk/portable.mk).
+WIN_DLLS := $(foreach c,$(CRATES),$(call win_dll,$(c)))
+$(WIN_DLLS) &: FORCE | libclang windows-toolchain
+	@mm_malloc=$$(ls /usr/lib/llvm-*/lib/clang/*/include/mm_malloc.h 2>/dev/null | sort -V | tail -n 1); \
+	[ -n "$$mm_malloc" ] || { echo "clang's mm_malloc.h not found (libclang-dev installs it)"; exit 1; }; \
+	export BINDGEN_EXTRA_CLANG_ARGS_x86_64_pc_windows_gnu="-I$$(dirname "$$mm_malloc")"; \
+	echo "BINDGEN_EXTRA_CLANG_ARGS_x86_64_pc_windows_gnu=$$BINDGEN_EXTRA_CLANG_ARGS_x86_64_pc_windows_gnu"; \
+	echo "cargo build --release $(addprefix -p ,$(CRATES)) --lib --target $(WIN_TARGET)"; \
+	cargo build --release $(addprefix -p ,$(CRATES)) --lib --target $(WIN_TARGET)
 
-$(FMU_DEBUG)/win64/$(1).dll: $(call win_dll,$(2))
-endef
-$(foreach m,$(MODELS),$(eval $(call windows_rules,$(m),$(crate_$(m)))))
+$(foreach m,$(MODELS),$(eval $(FMU_DEBUG)/win64/$(m).dll: $(call win_dll,$(crate_$(m)))))
 
 ## test-windows: the win64 DLLs under Wine agree with the linux64 .so; their export/import tables
 test-windows: fmu | windows-toolchain windows-wine

@@ -13,9 +13,9 @@
 //!   a piecewise ODE with one guard per gear and one for the damper;
 //! - [`instance`]: the slave of fmi2-shell (variables, co-simulation stepping, Model
 //!   Exchange's states and events; the shell applies FMI's rules around it);
-//! - the `fmi2*` C exports of Co-Simulation and Model Exchange: [`fmi2_shell`]'s, around
-//!   [`instance::Instance`], and the `fmi3*` ones of FMI 3.0 beside them ([`fmi3_shell`]'s,
-//!   around the same instance);
+//! - [`exports!`]: the `fmi2*` C exports of Co-Simulation and Model Exchange, [`fmi2_shell`]'s,
+//!   around [`instance::Instance`], and the `fmi3*` ones of FMI 3.0 beside them
+//!   ([`fmi3_shell`]'s), written by GearRattle.fmu's binary (fmus/GearRattle);
 //! - [`contract`]: value references and the model description, generated from
 //!   `modelDescription/GearRattle.toml` (packaged into the .fmu by the workspace's
 //!   `packaging` crate).
@@ -29,13 +29,21 @@ pub mod physics;
 pub mod rattle;
 
 /// Whether this build carries GearRattle's fmi2* and fmi3* exports (the default feature
-/// `fmu`): a library that links this crate for the model only (gearbox/) must be built
-/// without them.
+/// `fmu`, for the tests, the benchmarks and the fuzzer, which call them): the FMUs' binaries
+/// (fmus/) link this crate without them.
 pub const FMU_EXPORTS: bool = cfg!(feature = "fmu");
 
+/// GearRattle's `fmi2*` and `fmi3*` C exports around [`instance::Instance`] (fmi2-shell's and
+/// fmi3-shell's): written here with the feature `fmu`, and by GearRattle.fmu's binary
+/// (fmus/GearRattle), which links this crate without it.
+#[macro_export]
+macro_rules! exports {
+    () => {
+        ::fmi2_shell::export_co_simulation!($crate::instance::Instance);
+        ::fmi2_shell::export_model_exchange!($crate::instance::Instance);
+        ::fmi3_shell::export_fmi3!($crate::instance::Instance, $crate::contract);
+    };
+}
+
 #[cfg(feature = "fmu")]
-fmi2_shell::export_co_simulation!(crate::instance::Instance);
-#[cfg(feature = "fmu")]
-fmi2_shell::export_model_exchange!(crate::instance::Instance);
-#[cfg(feature = "fmu")]
-fmi3_shell::export_fmi3!(crate::instance::Instance, crate::contract);
+exports!();

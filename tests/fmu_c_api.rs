@@ -10,19 +10,22 @@ use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
 /// The cdylib under test: GEAR_RATTLE_CDYLIB (`make test` names the FMU's linux64 binary),
-/// else target/release/libgear_rattle.so, found from this test executable's path
+/// else target/release/libgear_rattle_fmu.so, found from this test executable's path
 /// (target/<profile>/deps/…).
 fn cdylib() -> PathBuf {
     let lib = std::env::var_os("GEAR_RATTLE_CDYLIB").map_or_else(
         || {
             let exe = std::env::current_exe().unwrap();
-            exe.ancestors().nth(3).unwrap().join("release/libgear_rattle.so")
+            exe.ancestors()
+                .nth(3)
+                .unwrap()
+                .join("release/libgear_rattle_fmu.so")
         },
         PathBuf::from,
     );
     assert!(
         lib.exists(),
-        "{} is missing: build it first with `cargo rustc --release -p gear_rattle --lib --crate-type cdylib` (make test builds the FMU's linux64 binary)",
+        "{} is missing: build it first with `cargo build --release -p gear_rattle_fmu` (make test builds the FMU's linux64 binary)",
         lib.display()
     );
     lib

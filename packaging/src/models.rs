@@ -10,7 +10,7 @@ pub fn gear_rattle() -> Model {
     };
     Model {
         identifier: MODEL_IDENTIFIER,
-        library: "gear_rattle",
+        library: "gear_rattle_fmu",
         model_description: MODEL_DESCRIPTION_XML,
         model_description_fmi3: Some(MODEL_DESCRIPTION_FMI3_XML),
         documentation: vec![
@@ -30,7 +30,7 @@ pub fn gearbox_rattle() -> Model {
     };
     Model {
         identifier: MODEL_IDENTIFIER,
-        library: "gearbox_rattle",
+        library: "gearbox_rattle_fmu",
         model_description: MODEL_DESCRIPTION_XML,
         model_description_fmi3: Some(MODEL_DESCRIPTION_FMI3_XML),
         documentation: vec![(

@@ -15,8 +15,8 @@ from gearrattle import reference as gear_reference
 
 GEARBOX_FMU_PATH = GF.GEARBOX_FMU
 BUILD_GEARBOX_FMU = (
-    "`make fmu` (or `cargo rustc --release -p gearbox_rattle --lib --crate-type cdylib && cargo run --release "
-    "-p packaging -- --model GearboxRattle --lib target/release/libgearbox_rattle.so --out target/fmu/GearboxRattle.fmu`)"
+    "`make fmu` (or `cargo build --release -p gearbox_rattle_fmu && cargo run --profile quick "
+    "-p packaging -- --model GearboxRattle --lib target/release/libgearbox_rattle_fmu.so --out target/fmu/GearboxRattle.fmu`)"
 )
 # Each scene's pointwise-predictable window [s] (the reference's own perturbed runs: a 1e-10 G
 # difference grows to 1e-4 G past it) and the rate spread of its perturbed runs beyond.
