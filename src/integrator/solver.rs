@@ -455,8 +455,11 @@ impl<const N: usize> Solver<N> {
 
     /// Keeps a step that reaches past t_end and hands out (t_end, y(t_end)) from its dense
     /// output.
-    fn keep(&mut self, mut ahead: Ahead<N>, t: &mut f64, y: &mut [f64; N], t_end: f64) {
-        (*t, *y) = (t_end, ahead.serve(t_end));
-        self.kept = Some(Kept::Step(ahead));
+    #[inline]
+    fn keep(&mut self, ahead: Ahead<N>, t: &mut f64, y: &mut [f64; N], t_end: f64) {
+        let Kept::Step(kept) = self.kept.insert(Kept::Step(ahead)) else {
+            unreachable!("a step was just kept");
+        };
+        (*t, *y) = (t_end, kept.serve(t_end));
     }
 }
