@@ -4,6 +4,9 @@ median over the rounds. Prints the figures; makes no timed assertion.
 
     .venv/bin/python scripts/bench_overhead.py --base target/dd70606 --new .
 
+With --instructions, each case runs once more alone under callgrind (valgrind), which counts
+the instructions executed inside fmi2DoStep: a measure the machine's load does not move.
+
 Cases: the base's FMU with its defaults; this FMU as a user runs it who reads no statistics
 (its defaults); this FMU with the statistics window open from --stats-from; then, for the
 shares of the extras, a window asked for after the run's end (its quadratures integrated,
@@ -16,8 +19,10 @@ import argparse
 import glob
 import os
 import statistics
+import re
 import subprocess
 import sys
+import tempfile
 import xml.etree.ElementTree as ET
 
 # The paper's scene S1 in sine mode.
@@ -54,6 +59,15 @@ def case(label, tree, start, read):
     return " ".join(line)
 
 
+def instructions(harness, line, args):
+    """Instructions executed inside fmi2DoStep by one trajectory of the case `line`."""
+    with tempfile.NamedTemporaryFile(suffix=".callgrind") as out:
+        subprocess.run(["valgrind", "--tool=callgrind", "--toggle-collect=fmi2DoStep",
+                        f"--callgrind-out-file={out.name}", harness, "1", "1", *args],
+                       input=line, capture_output=True, text=True, check=True)
+        return int(re.search(r"^summary: (\d+)", open(out.name).read(), re.M).group(1))
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--base", required=True, help="source tree of the base commit, built")
@@ -65,6 +79,8 @@ def main():
     ap.add_argument("--stats-from", type=float, default=0.2)
     ap.add_argument("--rounds", type=int, default=15)
     ap.add_argument("--repeats", type=int, default=10)
+    ap.add_argument("--instructions", action="store_true",
+                    help="also count each case's instructions under callgrind (needs valgrind)")
     a = ap.parse_args()
     both = (SAME[0] + WINDOW[0], SAME[1] + WINDOW[1])
     cases = [("base", a.base, S1, SAME),
@@ -74,8 +90,10 @@ def main():
              # after the run's end), then the whole window open from the start.
              ("window-after-the-end", a.new, dict(S1, stats_from=2 * a.duration), both),
              ("window-from-0s", a.new, dict(S1, stats_from=0.0), both)]
-    stdin = "".join(case(*c) + "\n" for c in cases)
-    argv = [a.harness, str(a.rounds), str(a.repeats), str(a.duration), str(a.step), str(a.tolerance)]
+    lines = [case(*c) + "\n" for c in cases]
+    stdin = "".join(lines)
+    run = [str(a.duration), str(a.step), str(a.tolerance)]
+    argv = [a.harness, str(a.rounds), str(a.repeats), *run]
     out = subprocess.run(argv, input=stdin, capture_output=True, text=True, check=True).stdout
     times, values = {}, {}
     for row in out.splitlines():
@@ -84,15 +102,17 @@ def main():
             times.setdefault(label, []).append(float(rest[0]))
         else:
             values[label] = rest
+    counted = [instructions(a.harness, line, run) if a.instructions else 0 for line in lines]
     base = statistics.median(times["base"])
     print(f"S1, {a.duration:g} s in communication steps of {a.step * 1e3:g} ms, tolerance {a.tolerance:g}: "
           f"CPU per trajectory, median of {a.rounds} rounds of {a.repeats} runs each, alternating")
-    for label, _, _, (reals, ints) in cases:
+    for (label, _, _, (reals, ints)), ir in zip(cases, counted):
         med = statistics.median(times[label])
         got = dict(zip(reals + ints, values[label]))
         same = all(got[n] == dict(zip(SAME[0] + SAME[1], values["base"]))[n] for n in SAME[0] + SAME[1])
         window = "  ".join(f"{n} {float(got[n]):.6g}" for n in reals + ints if n.startswith("stat_"))
-        print(f"  {label:20s} {med * 1e3:7.3f} ms  {med / base:5.3f}x base  steps {got['solver_steps']}, "
+        counts = f"{ir:11,d} instructions {ir / counted[0]:5.3f}x  " if a.instructions else ""
+        print(f"  {label:20s} {med * 1e3:7.3f} ms  {med / base:5.3f}x base  {counts}steps {got['solver_steps']}, "
               f"rhs {got['solver_rhs']}, trajectory {'the same bits' if same else 'DIFFERENT'}  {window}")
 
 

@@ -19,6 +19,9 @@ use crate::rattle::torque::{self, TorqueRattle};
 use crate::rattle::window::{Metrics, Quadratures, Window, quadrature};
 use crate::rattle::{self, GearPair, Impacts, KinematicRattle, LeanRattle, Rattle};
 use fmi2_shell::values::Values;
+use journal::{Entry, Journal};
+
+mod journal;
 
 /// Values of the `excitation` parameter.
 pub const EXCITATION_INPUTS: i64 = 0;
@@ -79,32 +82,33 @@ impl<S: Piecewise<N> + Jacobian<N> + Copy, const N: usize> Stepped<S, N> {
 
 impl<S: GearPair<N> + Jacobian<N> + Copy, const N: usize> Stepped<S, N> {
     /// Advances to t_end, through the opening of the statistics window on the way, where its
-    /// quadratures are kept; on failure the pair, its solver and t are left as they were.
-    /// With `at_impact`, stops at the first impact (contact onset) on the way, as located:
-    /// true if it did.
+    /// quadratures are kept. With `at_impact`, stops at the first impact (contact onset) on
+    /// the way, as located: true if it did. A failure leaves the pair where it failed (the
+    /// simulation's [`Journal`] puts it back).
     fn advance(&mut self, t: &mut f64, t_end: f64, at_impact: bool) -> Result<bool, SolverError> {
         let impacts = move |s: &S| {
             let count = s.impacts().count;
             if at_impact { count[0] + count[1] } else { 0 }
         };
         let window = self.system.window();
-        if window.is_opened() || window.from > t_end {
-            return self.advance_until(t, t_end, impacts);
+        if !window.is_opened() && window.from <= t_end {
+            if self.step(t, window.from, impacts)? {
+                return Ok(true);
+            }
+            self.open_window();
         }
-        let (before, t_before) = (*self, *t);
-        let advanced = self
-            .advance_until(t, window.from, impacts)
-            .and_then(|stopped| {
-                if stopped {
-                    return Ok(true);
-                }
-                self.open_window();
-                self.advance_until(t, t_end, impacts)
-            });
-        if advanced.is_err() {
-            (*self, *t) = (before, t_before);
-        }
-        advanced
+        self.step(t, t_end, impacts)
+    }
+
+    /// The solver's call towards t_end, stopping at the first edge that raises `events`.
+    fn step(
+        &mut self,
+        t: &mut f64,
+        t_end: f64,
+        events: impl Fn(&S) -> u64,
+    ) -> Result<bool, SolverError> {
+        self.solver
+            .advance_until(&mut self.system, t, &mut self.y, t_end, events)
     }
 
     /// The pair at t0 with the state's first components `head` (the quadratures from 0) and
@@ -165,8 +169,8 @@ impl<const N: usize> Stepped<KinematicRattle<N>, N> {
 }
 
 /// The gear pair in one of the two couplings, with the statistics window's quadratures or
-/// without. Plain data kept in place (it is copied whole for a rollback and serialized for
-/// the FMU state), so the larger variants are not boxed.
+/// without. Plain data kept in place (copied whole by the journal that puts a failed step
+/// back, and serialized for the FMU state), so the larger variants are not boxed.
 #[allow(clippy::large_enum_variant)]
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub enum Gear {
@@ -220,6 +224,9 @@ pub struct Simulation {
     pub gear: Gear,
     pub t: f64,
     pub drive: Drive,
+    /// What puts a failed step back (see `journal`).
+    #[serde(skip)]
+    journal: Journal,
 }
 
 /// What every output is computed from at the current time, whichever the coupling (the
@@ -360,7 +367,12 @@ impl Simulation {
                 }
             }
         };
-        Ok(Simulation { gear, t: t0, drive })
+        Ok(Simulation {
+            gear,
+            t: t0,
+            drive,
+            journal: Journal::default(),
+        })
     }
 
     /// The imposed motion of the shaft for a kinematic drive.
@@ -409,8 +421,16 @@ impl Simulation {
     /// ξ and ξ' follow the shaft (ξ = r_L θ_L − r_M θ_M): reading them right after reflects
     /// the new inputs (direct feedthrough). In the other modes the inputs are not used.
     pub fn set_shaft(&mut self, shaft: Shaft) {
+        if let Drive::Inputs(_) = self.drive {
+            self.journal.before(&self.gear, self.t, &self.drive);
+            self.apply_shaft(shaft);
+            self.journal.record(Entry::Shaft(shaft));
+        }
+    }
+
+    fn apply_shaft(&mut self, shaft: Shaft) {
         let Drive::Inputs(old) = self.drive else {
-            return;
+            unreachable!("inputs are applied in the inputs mode");
         };
         self.drive = Drive::Inputs(shaft);
         let (t, excitation) = (self.t, Self::excitation_from(self.drive, self.t));
@@ -427,9 +447,14 @@ impl Simulation {
     /// New torque on the main shaft and its rate (torque mode; ignored otherwise). The state
     /// does not jump: only the shaft's acceleration, read at once as alpha_M_out, changes.
     pub fn set_torque(&mut self, tau: f64, rate: f64) {
-        let Drive::Torque { .. } = self.drive else {
-            return;
-        };
+        if let Drive::Torque { .. } = self.drive {
+            self.journal.before(&self.gear, self.t, &self.drive);
+            self.apply_torque(tau, rate);
+            self.journal.record(Entry::Torque { tau, rate });
+        }
+    }
+
+    fn apply_torque(&mut self, tau: f64, rate: f64) {
         self.drive = Drive::Torque { tau, rate };
         let ramp = TorqueRamp {
             t0: self.t,
@@ -449,8 +474,53 @@ impl Simulation {
 
     /// Advances to t_end, or with `at_impact` to the first impact before it (its instant as
     /// the integrator locates it); returns the time reached. On failure the simulation is
-    /// left as it was.
+    /// left as it was (replayed by its [`Journal`]).
     pub fn step_until(&mut self, t_end: f64, at_impact: bool) -> Result<f64, SolverError> {
+        self.journal.before(&self.gear, self.t, &self.drive);
+        let from = self.t;
+        match self.advance(t_end, at_impact) {
+            Ok(reached) => {
+                self.journal.record(Entry::Step {
+                    from,
+                    to: t_end,
+                    at_impact,
+                });
+                Ok(reached)
+            }
+            Err(e) => {
+                self.replay();
+                Err(e)
+            }
+        }
+    }
+
+    /// Back to the state before the step that failed: the journal's copy, then the changes
+    /// made since.
+    #[cold]
+    fn replay(&mut self) {
+        let journal = self.journal;
+        let ((gear, t, drive), entries) = journal.replay();
+        (self.gear, self.t, self.drive) = (gear, t, drive);
+        for entry in entries {
+            match *entry {
+                Entry::Step {
+                    from,
+                    to,
+                    at_impact,
+                } => {
+                    self.t = from;
+                    self.advance(to, at_impact)
+                        .expect("a step that succeeded succeeds again from the same state");
+                }
+                Entry::Shaft(shaft) => self.apply_shaft(shaft),
+                Entry::Torque { tau, rate } => self.apply_torque(tau, rate),
+            }
+        }
+    }
+
+    /// [`step_until`](Self::step_until) without the journal: a failure leaves the simulation
+    /// where it failed.
+    fn advance(&mut self, t_end: f64, at_impact: bool) -> Result<f64, SolverError> {
         let stopped = on_gear!(&mut self.gear, k => k.advance(&mut self.t, t_end, at_impact)?);
         if !stopped {
             self.t = t_end;
@@ -687,6 +757,53 @@ mod tests {
             assert!(lean && !all, "{case:?}");
             assert!(impacts[0] + impacts[1] > 0, "{case:?}: {impacts:?}");
             assert_eq!((outputs, impacts), (outputs_all, impacts_all), "{case:?}");
+        }
+    }
+
+    /// A step that fails leaves the simulation as it was, solver and all (compared whole),
+    /// after more steps than a journal records, with new inputs among them and the
+    /// statistics window opening: its journal replays them. The step fails on its first attempt, below the
+    /// resolution of time, after the solver has evaluated the derivative there.
+    #[test]
+    fn a_failed_step_leaves_the_simulation_as_it_was() {
+        for (excitation, solver) in [
+            (EXCITATION_INPUTS, 0),
+            (EXCITATION_INPUTS, 2),
+            (EXCITATION_TORQUE, 0),
+        ] {
+            let mut values = Values::start(crate::contract::VARIABLES);
+            values.set_integer(vr::excitation, excitation);
+            values.set_integer(vr::solver, solver);
+            values.set_real(vr::omega_M, 30.0);
+            values.set_real(vr::tau_in, 0.5);
+            values.set_real(vr::stats_from, 2e-3);
+            let mut sim = Simulation::new(&values, 0.0, 0.0, 1e-6, Carry::Asked).unwrap();
+            let steps = journal::ENTRIES + journal::ENTRIES / 2;
+            for k in 1..=steps {
+                sim.step_to(k as f64 * 1e-4).unwrap();
+                // New inputs now and then (each mode takes its own).
+                if k % 7 == 0 {
+                    let shaft = sim.shaft();
+                    sim.set_shaft(Shaft {
+                        omega: shaft.omega + 0.1,
+                        ..shaft
+                    });
+                    sim.set_torque(0.5 + k as f64 * 1e-3, 2.0);
+                }
+            }
+            assert!(sim.journal.len() > 0 && sim.journal.len() < steps / 2);
+            let before = sim;
+            let t = sim.t;
+            assert!(sim.step_to(t + 4.0 * f64::EPSILON * t).is_err());
+            assert_eq!(sim, before, "{excitation}, {solver}");
+            assert_eq!(sim.stats(), before.stats());
+            // And it goes on as if the failed step had not been asked for.
+            let mut unfailed = before;
+            for k in steps + 1..=steps + 20 {
+                sim.step_to(k as f64 * 1e-4).unwrap();
+                unfailed.step_to(k as f64 * 1e-4).unwrap();
+            }
+            assert_eq!(sim, unfailed, "{excitation}, {solver}");
         }
     }
 }

@@ -226,8 +226,8 @@ impl<const N: usize> Solver<N> {
         }
         let t_start = *t;
         let mut call = Call::new(t_end);
-        // The series are written here in place, the DOPRI5 steps in `call.trial`.
-        let mut series = [[0.0; N]; taylor::TERMS];
+        // The Taylor steps are written here in place, the DOPRI5 steps in `call.trial`.
+        let mut series = taylor::Step::blank();
         while *t < t_end {
             if !self.just_crossed && sys.settle(*t, y) > 0 {
                 self.invalidate();
@@ -245,16 +245,15 @@ impl<const N: usize> Solver<N> {
                 }
             }
             call.past = self.interpolate_ends && self.rk.mode == Mode::Dopri5;
-            let series_step;
-            let step = if self.rk.mode == Mode::Dopri5 && sys.series(*t, y, &mut series) {
-                let natural = taylor::Step::length(&series, &self.tol);
+            let step = if self.rk.mode == Mode::Dopri5 && sys.series(*t, y, series.series_mut()) {
+                let natural = taylor::Step::length(series.series(), &self.tol);
                 let (h, last) = call.budget.step(*t, t_end, natural, call.past)?;
-                series_step = taylor::Step::new(series, h);
-                sys.observe(*t, h, &series_step);
+                series.set_length(h);
+                sys.observe(*t, h, &series);
                 self.stats.accepted += 1;
                 self.stats.series_steps += 1;
                 self.rk.stepped_by_series();
-                Taken::Series(&series_step, last)
+                Taken::Series(&series, last)
             } else {
                 let rough = self.just_crossed && sys.rough_start();
                 let attempt =
@@ -455,8 +454,11 @@ impl<const N: usize> Solver<N> {
 
     /// Keeps a step that reaches past t_end and hands out (t_end, y(t_end)) from its dense
     /// output.
-    fn keep(&mut self, mut ahead: Ahead<N>, t: &mut f64, y: &mut [f64; N], t_end: f64) {
-        (*t, *y) = (t_end, ahead.serve(t_end));
-        self.kept = Some(Kept::Step(ahead));
+    #[inline]
+    fn keep(&mut self, ahead: Ahead<N>, t: &mut f64, y: &mut [f64; N], t_end: f64) {
+        let Kept::Step(kept) = self.kept.insert(Kept::Step(ahead)) else {
+            unreachable!("a step was just kept");
+        };
+        (*t, *y) = (t_end, kept.serve(t_end));
     }
 }

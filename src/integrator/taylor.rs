@@ -34,8 +34,35 @@ impl<const N: usize> Step<N> {
     #[inline]
     pub fn new(c: Coefficients<N>, h: f64) -> Self {
         let mut step = Step { h, c, y1: [0.0; N] };
-        step.y1 = step.at(1.0);
+        step.set_length(h);
         step
+    }
+
+    /// A step to write in place: its series by [`series_mut`](Self::series_mut), then its
+    /// length by [`set_length`](Self::set_length).
+    pub fn blank() -> Self {
+        Step {
+            h: 0.0,
+            c: [[0.0; N]; TERMS],
+            y1: [0.0; N],
+        }
+    }
+
+    /// Its series about its start.
+    pub fn series(&self) -> &Coefficients<N> {
+        &self.c
+    }
+
+    /// Its series, to write.
+    pub fn series_mut(&mut self) -> &mut Coefficients<N> {
+        &mut self.c
+    }
+
+    /// The step ends at h, its end computed from its series.
+    #[inline]
+    pub fn set_length(&mut self, h: f64) {
+        self.h = h;
+        self.y1 = self.at(1.0);
     }
 
     /// The same series cut to end at θ ∈ [0, 1] of the step.
