@@ -1,8 +1,10 @@
 # The rattle as sound (docs/SOUND.md): the package python/gearrattle/sound (`gearrattle-study
 # listen`, --sound on the studies), its tests (tests/sound, run by pytest with the others:
-# pytest.ini), its benchmark and the A/B example of the docs. `make demo` writes the sound of S1.
+# pytest.ini), its benchmark and the A/B example of the docs. `make demo` writes the sound of S1
+# and of the default gearbox warm and cold.
 #   make bench-sound      CPU of the WAV and of the metrics against the simulation alone, and the
-#                         pressure's error against the force's sampling (printed)
+#                         pressure's error against the force's sampling (S1, 1 s), then the WAV of
+#                         10 s of the default gearbox against its simulation alone (printed)
 #   make sound-example    the A/B example of docs/SOUND.md (S1 against S3) -> docs/sound/
 
 SOUND_EXAMPLE := target/sound/ab_S1_S3
@@ -12,6 +14,7 @@ SOUND_EXAMPLE := target/sound/ab_S1_S3
 ## bench-sound: the sound's cost against the simulation alone, and its error against the force's sampling
 bench-sound: fmu $(VENV)/.installed
 	$(PY) -m gearrattle.sound.bench --fmu $(FMU) --duration 1
+	$(PY) -m gearrattle.sound.bench --fmu $(GEARBOX_FMU) --duration 10 --cost
 
 ## sound-example: the A/B example of docs/SOUND.md (S1 against S3) -> docs/sound/
 sound-example: fmu $(VENV)/.installed

@@ -161,28 +161,31 @@ pub fn check_parameters(variables: &[Variable], values: &Values) -> FmiResult {
         .iter()
         .filter(|v| v.causality == Causality::Parameter)
     {
-        let (value, shown) = match v.kind {
-            Kind::Real => (values.real(v.vr), format!("{:e}", values.real(v.vr))),
-            Kind::Integer => (
-                values.integer(v.vr) as f64,
-                values.integer(v.vr).to_string(),
-            ),
+        let value = match v.kind {
+            Kind::Real => values.real(v.vr),
+            Kind::Integer => values.integer(v.vr) as f64,
         };
-        let finite = v.kind == Kind::Integer || value.is_finite();
-        if !(finite && v.range.contains(value)) {
-            let statement = v.range.statement(v.name);
-            let allowed = match (v.kind, statement.is_empty()) {
-                (Kind::Real, true) => "finite values".to_string(),
-                (Kind::Real, false) => format!("{statement} (finite)"),
-                (Kind::Integer, _) => statement,
-            };
-            return Err(FmiError::error(format!(
-                "parameter {} = {shown} is invalid: allowed {allowed}",
-                v.name
-            )));
-        }
+        check_parameter(v, value)?;
     }
     Ok(())
+}
+
+/// Checks one parameter's value (an Integer's as f64) against its range.
+pub fn check_parameter(v: &Variable, value: f64) -> FmiResult {
+    let finite = v.kind == Kind::Integer || value.is_finite();
+    if finite && v.range.contains(value) {
+        return Ok(());
+    }
+    let statement = v.range.statement(v.name);
+    let (shown, allowed) = match (v.kind, statement.is_empty()) {
+        (Kind::Real, true) => (format!("{value:e}"), "finite values".to_string()),
+        (Kind::Real, false) => (format!("{value:e}"), format!("{statement} (finite)")),
+        (Kind::Integer, _) => ((value as i64).to_string(), statement),
+    };
+    Err(FmiError::error(format!(
+        "parameter {} = {shown} is invalid: allowed {allowed}",
+        v.name
+    )))
 }
 
 /// The error of a value reference the contract has no variable of that kind for.

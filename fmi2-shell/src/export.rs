@@ -7,8 +7,10 @@
 use crate::component::{Component, slice, slice_mut};
 use crate::fmu::Fmu;
 use crate::logger::Logger;
+use crate::packed::{self, Refusal};
 use crate::slave::{EventInfo, Interface, Slave};
 use crate::status::{FmiError, FmiResult, Status};
+use crate::values::Starts;
 use fmi_sys::fmi2::*;
 use std::ffi::CStr;
 use std::panic::{AssertUnwindSafe, catch_unwind};
@@ -26,12 +28,13 @@ pub unsafe fn text<'a>(s: fmi2String) -> Option<&'a str> {
     }
 }
 
-/// The interface fmi2Instantiate asks for, or the reason it refuses, checked before anything
-/// is allocated.
+/// The interface fmi2Instantiate asks for and the instance's start values, or the reason it
+/// refuses, checked before anything is allocated.
 unsafe fn check_instantiate<S: Slave>(
     fmu_type: fmi2Type,
     guid: fmi2String,
-) -> FmiResult<Interface> {
+    resource_location: fmi2String,
+) -> FmiResult<(Interface, Starts)> {
     let id = &S::IDENTITY;
     let interface = match fmu_type {
         t if t == fmi2Type_fmi2CoSimulation => Interface::CoSimulation,
@@ -43,32 +46,48 @@ unsafe fn check_instantiate<S: Slave>(
             )));
         }
     };
-    // SAFETY: the importer's string argument.
-    unsafe { check_token::<S>(guid) }?;
-    Ok(interface)
+    // SAFETY: the importer's string arguments.
+    let starts = unsafe { check_token::<S>(guid, resource_location) }?;
+    Ok((interface, starts))
 }
 
-/// Whether the importer's GUID (FMI 3.0: instantiationToken) is the one this binary was
-/// built with.
+/// The start values of the importer's GUID (FMI 3.0: instantiationToken): the contract's for
+/// the GUID this binary was built with, without reading anything; a packed model
+/// description's (beside `resources`, [`packed`]) for the GUID it names.
 ///
 /// # Safety
-/// `guid` is NULL or a NUL-terminated string.
-pub unsafe fn check_token<S: Slave>(guid: fmi2String) -> FmiResult {
+/// `guid` and `resources` are NULL or NUL-terminated strings.
+pub unsafe fn check_token<S: Slave>(guid: fmi2String, resources: fmi2String) -> FmiResult<Starts> {
     let id = &S::IDENTITY;
     // SAFETY: the importer's string argument.
-    match unsafe { text(guid) } {
-        Some(guid) if guid == id.guid => Ok(()),
-        other => Err(FmiError::error(format!(
-            "GUID {other:?} does not match this binary's {}: the model description and the binary are from different builds",
+    let Some(guid) = (unsafe { text(guid) }) else {
+        return Err(FmiError::error(format!(
+            "no GUID given (NULL or not UTF-8): this binary's is {}",
             id.guid
-        ))),
+        )));
+    };
+    if guid == id.guid {
+        return Ok(Starts::default());
     }
+    // SAFETY: the importer's string argument.
+    let resources = unsafe { text(resources) };
+    packed::starts(id, guid, resources).map_err(|refusal| match refusal {
+        Refusal::Invalid(e) => FmiError::error(format!(
+            "the model description beside the binary (GUID {guid}) has an invalid start value: {}",
+            e.message
+        )),
+        Refusal::Mismatch(why) => FmiError::error(format!(
+            "GUID {guid} does not match this binary's {}, and no model description matching it was found beside the binary ({why}): the model description and the binary are from different builds",
+            id.guid
+        )),
+    })
 }
 
 pub unsafe fn instantiate<S: Slave>(
     instance_name: fmi2String,
     fmu_type: fmi2Type,
     guid: fmi2String,
+    resource_location: fmi2String,
     functions: *const fmi2CallbackFunctions,
     logging_on: fmi2Boolean,
 ) -> fmi2Component {
@@ -83,14 +102,15 @@ pub unsafe fn instantiate<S: Slave>(
             "fmi2Instantiate",
             instance_name,
             |name| Logger::new(callback, environment, name),
-            || check_instantiate::<S>(fmu_type, guid),
+            || check_instantiate::<S>(fmu_type, guid, resource_location),
             logging_on != 0,
         )
     }
 }
 
-/// A new instance behind a component pointer, or NULL (logged) for an empty name or the
-/// error `check` finds in the importer's other arguments (no panic crosses the C boundary).
+/// A new instance behind a component pointer, from the start values `check` gives, or NULL
+/// (logged) for an empty name or the error `check` finds in the importer's other arguments
+/// (no panic crosses the C boundary).
 ///
 /// # Safety
 /// `instance_name` is NULL or a NUL-terminated string; `check` reads only valid arguments.
@@ -98,7 +118,7 @@ pub unsafe fn create<S: Slave>(
     function: &str,
     instance_name: fmi2String,
     logger: impl FnOnce(&CStr) -> Logger,
-    check: impl FnOnce() -> FmiResult<Interface>,
+    check: impl FnOnce() -> FmiResult<(Interface, Starts)>,
     logging_on: bool,
 ) -> fmi2Component {
     catch_unwind(AssertUnwindSafe(|| {
@@ -120,17 +140,19 @@ pub unsafe fn create<S: Slave>(
             );
             return std::ptr::null_mut();
         }
-        let interface = match check() {
-            Ok(interface) => interface,
+        let fmu = check().and_then(|(interface, starts)| {
+            let mut fmu = Fmu::<S>::new(logging_on, interface);
+            fmu.start_from(starts)?;
+            Ok(fmu)
+        });
+        let fmu = match fmu {
+            Ok(fmu) => fmu,
             Err(e) => {
                 logger.log(e.status, error, &format!("{function}: {}", e.message));
                 return std::ptr::null_mut();
             }
         };
-        let component = Box::new(Component {
-            fmu: Fmu::<S>::new(logging_on, interface),
-            logger,
-        });
+        let component = Box::new(Component { fmu, logger });
         Box::into_raw(component) as fmi2Component
     }))
     .unwrap_or(std::ptr::null_mut())

@@ -9,6 +9,7 @@ use crate::slave::{Interface, Slave};
 use crate::state::FmiState;
 use crate::status::{FmiError, FmiResult};
 use crate::time;
+use crate::values::Starts;
 use serde::{Deserialize, Serialize};
 
 /// The FMI state, the times and the slave. All of it is the FMU state (fmi2GetFMUstate)
@@ -27,6 +28,10 @@ pub struct Fmu<S> {
     #[serde(skip)]
     pub events: CoSimulationEvents,
     pub slave: S,
+    /// Start values other than the contract's (a packed model description's), applied at
+    /// instantiation and at each reset; the instance's, not part of its FMU state.
+    #[serde(skip)]
+    starts: Starts,
 }
 
 /// FMI 3.0's Co-Simulation with events ([`Slave::STEPS_TO_EVENTS`]): what the importer allows
@@ -49,7 +54,19 @@ impl<S: Slave> Fmu<S> {
             last_successful_time: 0.0,
             events: CoSimulationEvents::default(),
             slave: S::new(logging_on, interface),
+            starts: Starts::default(),
         }
+    }
+
+    /// Takes `starts` as its start values: set as fmi2SetReal/SetInteger set them, and
+    /// again at every reset.
+    pub fn start_from(&mut self, starts: Starts) -> FmiResult {
+        let (vrs, values): (Vec<u32>, Vec<f64>) = starts.real.iter().copied().unzip();
+        self.set_real(&vrs, &values)?;
+        let (vrs, values): (Vec<u32>, Vec<i32>) = starts.integer.iter().copied().unzip();
+        self.set_integer(&vrs, &values)?;
+        self.starts = starts;
+        Ok(())
     }
 
     pub fn interface(&self) -> Interface {
@@ -219,14 +236,17 @@ impl<S: Slave> Fmu<S> {
 
     fn take_over(&mut self, saved: &Self) {
         let (log, events) = (std::mem::take(self.log()), self.events);
+        let starts = std::mem::take(&mut self.starts);
         *self = saved.clone();
         *self.log() = log;
         self.events = events;
+        self.starts = starts;
     }
 
     /// fmi2Reset: back to the state after instantiation, the logging settings kept.
     pub fn reset(&mut self) -> FmiResult {
-        let fresh = Self::new(false, self.interface());
+        let mut fresh = Self::new(false, self.interface());
+        fresh.start_from(self.starts.clone())?;
         self.take_over(&fresh);
         Ok(())
     }
@@ -311,6 +331,7 @@ mod tests {
             state_version: 1,
             model_exchange: true,
             variable,
+            variables: &VARIABLES,
         };
 
         fn new(_logging_on: bool, interface: Interface) -> Self {
@@ -413,6 +434,28 @@ mod tests {
         assert_eq!(fmu.slave.values, [2.0, 1.0, 1.0]);
         fmu.reset().unwrap();
         assert_eq!(fmu.state, FmiState::Instantiated);
+    }
+
+    /// Start values other than the contract's are set at the start and again at each reset,
+    /// and survive taking over an FMU state.
+    #[test]
+    fn packed_start_values_outlive_resets() {
+        let mut fmu = Fmu::<Integrator>::new(false, Interface::CoSimulation);
+        let saved = fmu.snapshot();
+        let starts = Starts {
+            real: vec![(0, 4.0)],
+            integer: vec![],
+        };
+        fmu.start_from(starts).unwrap();
+        fmu.set_real(&[0], &[2.0]).unwrap();
+        fmu.restore(&saved).unwrap();
+        fmu.reset().unwrap();
+        assert_eq!(fmu.slave.values, [4.0, 1.0, 1.0]);
+        let bad = Starts {
+            real: vec![(2, 4.0)],
+            integer: vec![],
+        };
+        assert!(fmu.start_from(bad).is_err());
     }
 
     /// Model Exchange: event mode after initialisation, a finite time set is the instance's

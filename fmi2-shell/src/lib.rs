@@ -12,6 +12,8 @@
 //!   magic, version, GUID and a CRC;
 //! - statuses and errors in FMI's terms ([`status`]), and the store of the values set
 //!   ([`values`]);
+//! - a packed FMU's start values, read from the model description beside the binary when
+//!   the importer's GUID is not the built-in one ([`packed`]);
 //! - the types of the contract and the checks of a variable's setting ([`contract`]) and, for
 //!   build scripts, the generator of the model description and of the constants from the
 //!   contract TOML (`build`, feature "build"), and the variable tables of the documentation
@@ -32,6 +34,8 @@ pub mod log;
 pub mod logger;
 #[cfg(feature = "runtime")]
 mod macros;
+#[cfg(feature = "runtime")]
+pub mod packed;
 pub mod slave;
 pub mod state;
 pub mod status;

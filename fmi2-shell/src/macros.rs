@@ -84,12 +84,12 @@ macro_rules! export_co_simulation {
                 instanceName: fmi2String,
                 fmuType: fmi2Type,
                 fmuGUID: fmi2String,
-                _fmuResourceLocation: fmi2String,
+                fmuResourceLocation: fmi2String,
                 functions: *const fmi2CallbackFunctions,
                 _visible: fmi2Boolean,
                 loggingOn: fmi2Boolean,
             ) -> fmi2Component {
-                unsafe { e::instantiate::<S>(instanceName, fmuType, fmuGUID, functions, loggingOn) }
+                unsafe { e::instantiate::<S>(instanceName, fmuType, fmuGUID, fmuResourceLocation, functions, loggingOn) }
             }
             #[unsafe(no_mangle)]
             pub unsafe extern "C" fn fmi2FreeInstance(c: fmi2Component) {

@@ -27,6 +27,10 @@ pub struct Identity {
     /// The contract's variable of a kind and value reference, or the error for an unknown
     /// one (the generated `contract::variable`): the shell checks fmi2Set* against it.
     pub variable: fn(Kind, u32) -> FmiResult<&'static Variable>,
+    /// Every variable of the contract, in the model description's order (the generated
+    /// `contract::VARIABLES`): a packed model description is checked against it
+    /// ([`crate::packed`]).
+    pub variables: &'static [Variable],
 }
 
 /// The interface an instance was instantiated for.

@@ -5,6 +5,14 @@ use crate::contract::{Kind, Start, Variable};
 use crate::status::{FmiError, FmiResult};
 use serde::{Deserialize, Serialize};
 
+/// Start values other than the contract's, by value reference: a packed model description's
+/// ([`crate::packed`]), which an instance applies at instantiation and again at fmi2Reset.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Starts {
+    pub real: Vec<(u32, f64)>,
+    pub integer: Vec<(u32, i32)>,
+}
+
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Values {
     real: Vec<f64>,

@@ -16,14 +16,16 @@ use fmi2_shell::{
 };
 
 /// fmi3InstantiateModelExchange and fmi3InstantiateCoSimulation: an instance of the
-/// interface `wanted` if the token is this binary's and the model offers the interface, else
-/// NULL and a log line (`wanted` is the reason the caller found in the interface's own
-/// arguments to refuse).
+/// interface `wanted` if the token is this binary's (or a packed model description's beside
+/// `resource_path`) and the model offers the interface, else NULL and a log line (`wanted`
+/// is the reason the caller found in the interface's own arguments to refuse).
+#[allow(clippy::too_many_arguments)] // FMI 3.0's arguments, as the exports receive them
 pub unsafe fn instantiate<S: Slave>(
     function: &str,
     wanted: Result<Interface, &str>,
     instance_name: fmi3String,
     token: fmi3String,
+    resource_path: fmi3String,
     logging_on: bool,
     environment: fmi3InstanceEnvironment,
     log_message: fmi3LogMessageCallback,
@@ -36,9 +38,9 @@ pub unsafe fn instantiate<S: Slave>(
                 S::IDENTITY.model_identifier
             )));
         }
-        // SAFETY: the importer's string argument.
-        unsafe { check_token::<S>(token) }?;
-        Ok(interface)
+        // SAFETY: the importer's string arguments.
+        let starts = unsafe { check_token::<S>(token, resource_path) }?;
+        Ok((interface, starts))
     };
     // SAFETY: the importer's arguments.
     unsafe {
@@ -54,9 +56,11 @@ pub unsafe fn instantiate<S: Slave>(
 
 /// fmi3InstantiateCoSimulation: an instance as [`instantiate`] makes it, with the events the
 /// importer allows (eventModeUsed refused for a model whose steps do not end at events).
+#[allow(clippy::too_many_arguments)] // FMI 3.0's arguments, as the exports receive them
 pub unsafe fn instantiate_co_simulation<S: Slave>(
     instance_name: fmi3String,
     token: fmi3String,
+    resource_path: fmi3String,
     logging_on: bool,
     event_mode_used: bool,
     early_return_allowed: bool,
@@ -76,6 +80,7 @@ pub unsafe fn instantiate_co_simulation<S: Slave>(
             wanted,
             instance_name,
             token,
+            resource_path,
             logging_on,
             environment,
             log_message,

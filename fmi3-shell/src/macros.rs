@@ -34,7 +34,7 @@ macro_rules! __fmi3_exports {
             pub unsafe extern "C" fn fmi3InstantiateModelExchange(
                 instanceName: fmi3String,
                 instantiationToken: fmi3String,
-                _resourcePath: fmi3String,
+                resourcePath: fmi3String,
                 _visible: fmi3Boolean,
                 loggingOn: fmi3Boolean,
                 instanceEnvironment: fmi3InstanceEnvironment,
@@ -42,7 +42,7 @@ macro_rules! __fmi3_exports {
             ) -> fmi3Instance {
                 unsafe {
                     e3::instantiate::<S>("fmi3InstantiateModelExchange", Ok(Interface::ModelExchange),
-                        instanceName, instantiationToken, loggingOn, instanceEnvironment, logMessage)
+                        instanceName, instantiationToken, resourcePath, loggingOn, instanceEnvironment, logMessage)
                 }
             }
             // The model's own early return at its events (where it offers them) and event mode
@@ -52,7 +52,7 @@ macro_rules! __fmi3_exports {
             pub unsafe extern "C" fn fmi3InstantiateCoSimulation(
                 instanceName: fmi3String,
                 instantiationToken: fmi3String,
-                _resourcePath: fmi3String,
+                resourcePath: fmi3String,
                 _visible: fmi3Boolean,
                 loggingOn: fmi3Boolean,
                 eventModeUsed: fmi3Boolean,
@@ -64,8 +64,8 @@ macro_rules! __fmi3_exports {
                 _intermediateUpdate: fmi3IntermediateUpdateCallback,
             ) -> fmi3Instance {
                 unsafe {
-                    e3::instantiate_co_simulation::<S>(instanceName, instantiationToken, loggingOn,
-                        eventModeUsed, earlyReturnAllowed, instanceEnvironment, logMessage)
+                    e3::instantiate_co_simulation::<S>(instanceName, instantiationToken, resourcePath,
+                        loggingOn, eventModeUsed, earlyReturnAllowed, instanceEnvironment, logMessage)
                 }
             }
             /// Scheduled execution is not offered: no instance.

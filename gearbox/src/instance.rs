@@ -7,6 +7,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::contract::{self, Causality, Kind, LOG_CATEGORIES, VARIABLES, vr};
 use crate::model_exchange::NX;
+use crate::outputs::Now;
 use crate::simulation::{self, Simulation};
 use fmi2_shell::values::Values;
 use fmi2_shell::vectors::{fill, states};
@@ -53,6 +54,19 @@ impl Instance {
             self.sim = Some(self.build()?);
         }
         Ok(self.sim.as_ref().expect("built above"))
+    }
+
+    /// Builds the simulation (as [`Self::current`]) when `vrs` asks for a computed variable, so
+    /// that a getter computes its outputs from one readout ([`Now`]) for the whole call.
+    fn build_if_computed(&mut self, kind: Kind, vrs: &[u32]) -> FmiResult {
+        let computed = |vr: &u32| {
+            contract::variable(kind, *vr)
+                .is_ok_and(|v| matches!(v.causality, Causality::Output | Causality::Local))
+        };
+        if vrs.iter().any(computed) {
+            self.current()?;
+        }
+        Ok(())
     }
 
     fn sim_mut(&mut self) -> &mut Simulation {
@@ -198,6 +212,7 @@ impl Slave for Instance {
         state_version: 1,
         model_exchange: true,
         variable: contract::variable,
+        variables: contract::VARIABLES,
     };
 
     fn new(logging_on: bool, interface: Interface) -> Self {
@@ -238,12 +253,14 @@ impl Slave for Instance {
     }
 
     fn get_real(&mut self, vrs: &[u32], out: &mut [f64]) -> FmiResult {
+        self.build_if_computed(Kind::Real, vrs)?;
+        let now = self.sim.as_ref().map(Now::new);
         for (vr, out) in vrs.iter().zip(out) {
             let var = contract::variable(Kind::Real, *vr)?;
             *out = match var.causality {
-                Causality::Output | Causality::Local => self
-                    .current()?
-                    .real_output(*vr)
+                Causality::Output | Causality::Local => now
+                    .as_ref()
+                    .and_then(|now| now.real(*vr))
                     .expect("every computed Real variable of the contract is computed"),
                 _ => self.values.real(*vr),
             };
@@ -258,12 +275,14 @@ impl Slave for Instance {
     }
 
     fn get_integer(&mut self, vrs: &[u32], out: &mut [i32]) -> FmiResult {
+        self.build_if_computed(Kind::Integer, vrs)?;
+        let now = self.sim.as_ref().map(Now::new);
         for (vr, out) in vrs.iter().zip(out) {
             let var = contract::variable(Kind::Integer, *vr)?;
             let value = match var.causality {
-                Causality::Output => self
-                    .current()?
-                    .integer_output(*vr)
+                Causality::Output => now
+                    .as_ref()
+                    .and_then(|now| now.integer(*vr))
                     .expect("every Integer output of the contract is computed"),
                 _ => self.values.integer(*vr),
             };

@@ -10,15 +10,16 @@ use crate::windowed;
 use gear_rattle::gearbox::{Gearbox, Readout};
 use gear_rattle::rattle::window::Metrics;
 
-/// What the outputs are computed from now.
-struct Now<'a> {
+/// What the outputs are computed from now: the gearbox's readout, once for every output read
+/// at this instant.
+pub struct Now<'a> {
     sim: &'a Simulation,
     gearbox: Gearbox,
     readout: Readout,
 }
 
 impl<'a> Now<'a> {
-    fn new(sim: &'a Simulation) -> Self {
+    pub fn new(sim: &'a Simulation) -> Self {
         let (gearbox, y) = sim.observed();
         Now {
             sim,
@@ -91,26 +92,44 @@ fn per_second(m: &Metrics, x: f64) -> f64 {
     if m.length > 0.0 { x / m.length } else { 0.0 }
 }
 
-impl Simulation {
-    /// The value of a Real output or local, computed now; None if `vr` is none.
-    pub fn real_output(&self, vr: u32) -> Option<f64> {
-        let now = Now::new(self);
-        let b = &now.readout.input;
+impl Now<'_> {
+    /// The value of a Real output or local; None if `vr` is none.
+    pub fn real(&self, vr: u32) -> Option<f64> {
+        let b = &self.readout.input;
         Some(match vr {
             vr::tau_F => -b.T_cl,
-            vr::tau_I => now.tau_I(),
+            vr::tau_I => self.tau_I(),
             vr::theta_I_out => b.theta_I,
             vr::omega_I_out => b.omega_I,
             vr::alpha_I_out => b.alpha_I,
             vr::phi => b.phi,
             vr::T_clutch => b.T_cl,
-            vr::T_drag => now.T_drag(),
+            vr::T_drag => self.T_drag(),
             vr::E_damper => b.e_damper,
-            vr::stat_rattle_power => now.box_rattle_power(),
+            vr::stat_rattle_power => self.box_rattle_power(),
             _ => vr::gear::locate(vr)
-                .and_then(|(i, offset)| gear_real(&now, i, offset))
-                .or_else(|| self.model_exchange_local(vr))?,
+                .and_then(|(i, offset)| gear_real(self, i, offset))
+                .or_else(|| self.sim.model_exchange_local(vr))?,
         })
+    }
+
+    /// The value of an Integer output; None if `vr` is none.
+    pub fn integer(&self, vr: u32) -> Option<i64> {
+        Some(match vr {
+            vr::damper_stage => 1 + i64::from(self.readout.input.stage.abs()),
+            vr::stat_loudest_gear => self.loudest_gear(),
+            _ => {
+                let (i, offset) = vr::gear::locate(vr)?;
+                gear_integer(self, i, offset)?
+            }
+        })
+    }
+}
+
+impl Simulation {
+    /// The value of a Real output or local, computed now; None if `vr` is none.
+    pub fn real_output(&self, vr: u32) -> Option<f64> {
+        Now::new(self).real(vr)
     }
 
     /// The Model Exchange variables that are not outputs: the state x_omega_I and the
@@ -123,17 +142,9 @@ impl Simulation {
         Some(self.derivatives()[k])
     }
 
-    /// The value of an Integer output; None if `vr` is none.
+    /// The value of an Integer output, computed now; None if `vr` is none.
     pub fn integer_output(&self, vr: u32) -> Option<i64> {
-        let now = Now::new(self);
-        Some(match vr {
-            vr::damper_stage => 1 + i64::from(now.readout.input.stage.abs()),
-            vr::stat_loudest_gear => now.loudest_gear(),
-            _ => {
-                let (i, offset) = vr::gear::locate(vr)?;
-                gear_integer(&now, i, offset)?
-            }
-        })
+        Now::new(self).integer(vr)
     }
 }
 

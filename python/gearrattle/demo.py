@@ -13,6 +13,7 @@ from . import gearbox_demo
 from . import rattle_stats as rs
 from .scene_figures import overview_figure, scene_figure
 from .scenes import SCENES, analyse, dist_str, read_params, simulate
+from .sound import demo as sound_demo
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 FMU = os.path.join(ROOT, "target", "fmu", "GearRattle.fmu")
@@ -143,26 +144,6 @@ def print_summary(results, t_from):
         print("  - " + v)
 
 
-def s1_sound(fmu, out, duration):
-    """The sound of S1 through the default housing (gearrattle-study listen, docs/SOUND.md):
-    out/S1_sound/ and out/S1_rattle.wav; prints its loudness and sharpness."""
-    import json
-    import shutil
-
-    from .study.cli import main as study
-
-    where = os.path.join(out, "S1_sound")
-    if study(["listen", "--fmu", fmu, "--duration", str(duration), "--out", where, "--quiet"]):
-        raise RuntimeError("gearrattle-study listen failed")
-    wav = shutil.copy(os.path.join(where, "rattle.wav"), os.path.join(out, "S1_rattle.wav"))
-    with open(os.path.join(where, "sound.json")) as fh:
-        s = json.load(fh)["scenes"][0]
-    print(f"\nS1 heard through the default housing ({wav}, docs/SOUND.md): loudness N5 "
-          f"{s['N5']:.2f} sone (mean {s['N_mean']:.2f}), sharpness {s['sharpness']:.2f} acum, "
-          f"LAeq {s['LAeq']:.1f} dB(A)")
-    return os.path.join(where, "spectrogram.png")
-
-
 def run(fmu=FMU, out=OUT, duration=1.0, interval=1e-5, scenes="S1,S2,S3", box_fmu=None):
     """Run the scenes named in `scenes` (comma-separated) for `duration` s each with outputs
     every `interval` s, print their statistics and the comparison with the paper, write the
@@ -210,8 +191,15 @@ def run(fmu=FMU, out=OUT, duration=1.0, interval=1e-5, scenes="S1,S2,S3", box_fm
 
     if results:
         print_summary(results, t_from)
+    heard = []
     if any(s["name"] == "S1" for s, *_ in results):
-        figures.append(s1_sound(fmu, out, duration))
+        t_sound = time.perf_counter()
+        row, figure = sound_demo.s1(fmu, out, duration)
+        heard.append(row)
+        figures.append(figure)
+        if box_fmu is None:
+            sound_demo.print_table(heard)
+        print(f"sound of S1: {time.perf_counter() - t_sound:.1f} s")
     print()
     print(f"total demo time {time.perf_counter() - t_all:.1f} s "
           f"(simulate_fmu {sum(r[2] for r in results):.1f} s)")
@@ -222,17 +210,24 @@ def run(fmu=FMU, out=OUT, duration=1.0, interval=1e-5, scenes="S1,S2,S3", box_fm
         print(f"FAILED scenes: {', '.join(failed)}")
         return 1
     if box_fmu is not None:
-        return run_gearbox(box_fmu, out)
+        return run_gearbox(box_fmu, out, heard)
     return 0
 
 
-def run_gearbox(box_fmu, out=OUT):
-    """The gearbox demo and its figures; the exit code (2: no FMU)."""
+def run_gearbox(box_fmu, out=OUT, heard=()):
+    """The gearbox demo and its figures, then its sound warm and cold with the metrics of the
+    sounds `heard` before it (S1's) beside; the exit code (2: no FMU)."""
     if not os.path.isfile(box_fmu):
         print(f"demo: no gearbox FMU at {box_fmu}: build it first", file=sys.stderr)
         return 2
     os.makedirs(out, exist_ok=True)
     figures = gearbox_demo.run(box_fmu, out)
+    t_sound = time.perf_counter()
+    rows, figure = sound_demo.gearbox(box_fmu, out)
+    sound_demo.print_table([*heard, *rows])
+    figures.append(figure)
+    print(f"sound of the gearbox warm and cold: {time.perf_counter() - t_sound:.1f} s "
+          f"(per-gear stems in {os.path.join(out, 'gearbox_sound')}/A and B)")
     print("figures:")
     for f in figures:
         print("  " + f)

@@ -302,6 +302,7 @@ impl Slave for Instance {
         state_version: 7,
         model_exchange: true,
         variable: contract::variable,
+        variables: contract::VARIABLES,
     };
 
     fn interface(&self) -> Interface {

@@ -14,21 +14,22 @@ import pytest
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 FMU = ROOT / "target" / "fmu" / "GearRattle.fmu"
+GEARBOX_FMU = ROOT / "target" / "fmu" / "GearboxRattle.fmu"
 STUDY = pathlib.Path(sys.executable).parent / "gearrattle-study"
 FS = 48000
 
 
-def fmu():
-    if not FMU.is_file():
-        pytest.fail(f"{FMU} does not exist: build it first with `make fmu`, then rerun the tests",
-                    pytrace=False)
-    return str(FMU)
+def fmu(path=FMU):
+    if not path.is_file():
+        pytest.fail(f"{path} does not exist: build it first with `make fmu`, then rerun the "
+                    f"tests", pytrace=False)
+    return str(path)
 
 
-def listen(*args, check=True, process=False):
+def listen(*args, check=True, process=False, fmu_path=FMU):
     """Run `gearrattle-study listen` with these arguments: (exit code, stderr). In this process
     (the command's main with these arguments), or as a user runs it (process=True)."""
-    argv = ["listen", "--fmu", fmu(), *map(str, args), "--quiet"]
+    argv = ["listen", "--fmu", fmu(fmu_path), *map(str, args), "--quiet"]
     if process:
         p = subprocess.run([str(STUDY), *argv], capture_output=True, text=True, timeout=120)
         code, err = p.returncode, p.stderr
@@ -48,15 +49,20 @@ def sound_json(out):
     return json.loads((pathlib.Path(out) / "sound.json").read_text())
 
 
-def impact_samples(duration, start_values, subsample=4):
-    """The first WAV sample after each of the FMU's impacts: the counters read by simulate_fmu
-    every 1/(FS subsample) s give each impact's interval, within one WAV sample interval."""
+def impact_samples(duration, start_values, subsample=4, fmu_path=FMU, prefixes=("",)):
+    """Per prefix (a mesh: "" or "gear[i]."), the first WAV sample after each of its impacts:
+    the counters read by simulate_fmu every 1/(FS subsample) s give each impact's interval,
+    within one WAV sample interval. One array for the single prefix "", else a list."""
     from fmpy import simulate_fmu
 
     h = 1.0 / (FS * subsample)
-    r = simulate_fmu(fmu(), start_values={"excitation": 1, **start_values}, stop_time=duration,
-                     output_interval=h, output=["impacts_Fplus", "impacts_Fminus"])
-    n = r["impacts_Fplus"].astype(int) + r["impacts_Fminus"].astype(int)
-    k = np.nonzero(np.diff(n) > 0)[0] + 1
-    assert np.all(np.diff(n) <= 1), "two impacts in one output interval"
-    return (k + subsample - 1) // subsample  # the WAV sample at or after the interval's end
+    names = [p + c for p in prefixes for c in ("impacts_Fplus", "impacts_Fminus")]
+    r = simulate_fmu(fmu(fmu_path), start_values={"excitation": 1, **start_values},
+                     stop_time=duration, output_interval=h, output=names)
+    out = []
+    for p in prefixes:
+        n = r[p + "impacts_Fplus"].astype(int) + r[p + "impacts_Fminus"].astype(int)
+        k = np.nonzero(np.diff(n) > 0)[0] + 1
+        assert np.all(np.diff(n) <= 1), f"two impacts of {p or 'the mesh'} in one output interval"
+        out.append((k + subsample - 1) // subsample)  # the WAV sample at or after its end
+    return out[0] if prefixes == ("",) else out

@@ -5,7 +5,7 @@ import numpy as np
 import soundfile as sf
 
 from gearrattle.sound.metrics import read_wav
-from sound_support import FS, impact_samples, listen, sound_json
+from sound_support import FS, fmu, impact_samples, listen, sound_json
 
 DURATION = 0.2
 # One heavily damped mode: each burst dies out within a free flight, so a burst's onset is the
@@ -41,6 +41,30 @@ def test_burst_onsets_are_the_impacts_within_one_sample(tmp_path):
     assert len(got) == len(want), f"{len(got)} bursts in the WAV, {len(want)} impacts"
     late = got - want
     assert np.all((late >= 0) & (late <= 1)), f"onset - impact in samples: {late}"
+
+
+def test_from_hears_the_run_from_then_on_the_same_time_axis(tmp_path):
+    # A contact under way at t_from (read through simulate_fmu) is heard from the first sample.
+    from fmpy import simulate_fmu
+
+    t_from = 0.1
+    modes = tmp_path / "damped.toml"
+    modes.write_text(DAMPED)
+    listen("--duration", t_from + DURATION, "--from", t_from, "--transfer", modes,
+           "--out", tmp_path / "d")
+    p, _ = read_wav(tmp_path / "d" / "rattle.wav")
+    assert len(p) == round(DURATION * FS) + 1
+    whole = impact_samples(t_from + DURATION, {})
+    want = whole[whole > round(t_from * FS)] - round(t_from * FS)
+    at_from = simulate_fmu(fmu(), start_values={"excitation": 1}, stop_time=t_from,
+                           output=["F_contact"])["F_contact"][-1]
+    if at_from != 0:
+        want = np.r_[1, want]  # p[0] is the housing at rest under the held force
+    got = onsets(p)
+    assert len(want) > 40 and len(got) == len(want), f"{len(got)} bursts, {len(want)} impacts"
+    late = got - want
+    assert np.all((late >= 0) & (late <= 1)), f"onset - impact in samples: {late}"
+    assert sound_json(tmp_path / "d")["from_s"] == t_from
 
 
 def test_sound_starts_at_the_first_impact_with_the_default_housing(tmp_path):

@@ -123,3 +123,38 @@ def test_the_meshes_come_from_the_model_description():
     assert len(M.meshes(gearbox, {"n_gears": 8})) == 8
     pair = SimpleNamespace(modelVariables=[_variable("F_contact", "output")])
     assert [m.force.name for m in M.meshes(pair, {})] == ["F_contact"]
+
+
+def a_history(n, n0, h):
+    """A force that rises smoothly from 0 to 200 N over n0 / 2 samples, rests there, then
+    rattles: half-sine pulses of 1.4 ms on top of the 200 N from sample n0 on."""
+    t = np.arange(n) * h
+    F = 200.0 * np.sin(0.5 * np.pi * np.minimum(np.arange(n) / (n0 // 2), 1.0)) ** 2
+    phase = (t - n0 * h) % 5e-3
+    pulse = (t >= n0 * h) & (phase < 1.4e-3)
+    F[pulse] += 30.0 * np.sin(np.pi * phase[pulse] / 1.4e-3)
+    return F
+
+
+def held_start_error(pressure, F, n0, every=1):
+    """max |p| difference, relative to the peak, between the transfer applied to the whole
+    history (the housing at rest at its start, under no force) and applied from sample n0 on
+    alone (the force before n0 held at F[n0]); the pressure is at every `every`-th force
+    sample."""
+    whole = pressure(F)[n0 // every:]
+    cut = pressure(F[n0:])
+    return np.abs(cut - whole).max() / np.abs(whole).max()
+
+
+def test_a_recording_started_under_load_is_the_whole_history_heard_from_then():
+    # The smooth rise and the rest leave the housing silent at n0 (0.5 s): the history's
+    # pressure from n0 on is what a recording starting there under the 200 N must give, not a
+    # step response.
+    h = 1.0 / (FS * M.SUBSAMPLE)
+    n0 = int(0.5 / h)
+    F = a_history(n0 + int(0.05 / h), n0, h)
+    modal = ModalTransfer()
+    err = held_start_error(lambda f: modal.pressure(f, 0, h), F, n0)
+    assert err < 1e-6, f"held start differs by {err:.1e} of the peak"
+    silent = modal.pressure(np.full(1000, 200.0), 0, h)
+    assert np.abs(silent).max() < 1e-9, "a constant force sounds"

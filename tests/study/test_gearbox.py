@@ -54,33 +54,40 @@ def test_pack_runs_the_gearbox_with_no_setup(gearbox_fmu, tmp_path):
     starts = {v.name: v.start for v in read_model_description(out).modelVariables}
     for name, value in WANT.items():
         assert float(starts[name]) == value, name
-    # The packed FMU, its model description's start values applied as a drivetrain tool applies
-    # them (fmpy does not by itself), runs as the original told the TOML's values.
-    md = read_model_description(out)
-    given = {v.name: (int if v.type == "Integer" else float)(v.start) for v in md.modelVariables
-             if v.causality == "parameter" and v.start is not None}
+    # The packed FMU, given no start values, runs as the original told the TOML's values, in
+    # both interfaces (the binary starts from the model description it ships with).
     kw = dict(stop_time=0.2, output_interval=1e-3, output=OUT)
-    packed = simulate_fmu(out, start_values=given, **kw)
-    told = simulate_fmu(gearbox_fmu, start_values=WANT, **kw)
+    for interface in ("CoSimulation", "ModelExchange"):
+        packed = simulate_fmu(out, fmi_type=interface, **kw)
+        told = simulate_fmu(gearbox_fmu, fmi_type=interface, start_values=WANT, **kw)
+        for name in OUT:
+            assert np.array_equal(packed[name], told[name]), (interface, name)
     default = simulate_fmu(gearbox_fmu, **kw)
-    for name in OUT:
-        assert np.array_equal(packed[name], told[name]), name
     assert not np.array_equal(packed["gear[1].xi"], default["gear[1].xi"])
-    # Every other entry is the original's, byte for byte; the GUID is the binary's.
+    # Every other entry is the original's, byte for byte, beside the description's copy among
+    # the resources; the GUID is the box's own, the same for the same box.
     with zipfile.ZipFile(gearbox_fmu) as a, zipfile.ZipFile(out) as b:
-        assert a.namelist() == b.namelist()
+        assert b.namelist() == a.namelist() + [P.RESOURCE_XML]
         for name in a.namelist():
             if name != P.XML:
                 assert a.read(name) == b.read(name), name
-    assert read_model(out).guid == read_model(gearbox_fmu).guid
-    # The study runner sets the packed start values: a point of the packed FMU is the original's
-    # told the TOML's values.
+        assert b.read(P.RESOURCE_XML) == b.read(P.XML)
+    again = str(tmp_path / "again.fmu")
+    P.pack(_box(tmp_path), gearbox_fmu, again)
+    other = str(tmp_path / "other.fmu")
+    P.pack(_box(tmp_path, BOX.replace("k_1 = 20.0", "k_1 = 21.0")), gearbox_fmu, other)
+    guids = [read_model(f).guid for f in (gearbox_fmu, out, again, other)]
+    assert guids[1] == guids[2] and len(set(guids)) == 3, guids
+    # A study of the packed FMU (its instances reset between points) is the original's told
+    # the TOML's values, under the packed FMU's GUID.
     for fmu, extra in ((out, []), (gearbox_fmu, [f"--set={n}={v}" for n, v in WANT.items()])):
         study("map", "--fmu", fmu, "--x", "rpm=800:900:2", "--y", "T_oil=40:40:1",
               "--duration", "0.4", "--workers", "0", "--out", tmp_path / fmu[-8:], *extra)
     a_, b_ = (pq.read_table(tmp_path / fmu[-8:] / "points.parquet").drop(["cpu_s", "point_id"])
               for fmu in (out, gearbox_fmu))
-    assert a_.select(b_.column_names).equals(b_), "the packed FMU's study differs"
+    shared = [c for c in b_.column_names if c not in WANT and c != "guid"]
+    assert a_.select(shared).equals(b_.select(shared)), "the packed FMU's study differs"
+    assert set(a_["guid"].to_pylist()) == {guids[1]}
 
 
 @pytest.mark.parametrize("text,named,fix", [

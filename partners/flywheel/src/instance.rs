@@ -59,6 +59,7 @@ impl Slave for Instance {
         state_version: 3,
         model_exchange: false,
         variable: contract::variable,
+        variables: contract::VARIABLES,
     };
 
     fn new(logging_on: bool, _interface: Interface) -> Self {

@@ -1,9 +1,10 @@
 """The sound's cost and error against the force's sampling (make bench-sound): CPU times of the
 simulation alone (one fmi2DoStep), of the simulation stepped on the sound's grid, of the
 filtering, of writing the WAV and of the psychoacoustic metrics (MoSQITo), for a scene; and the
-pressure's error at each subsample against a 32-times-finer grid.
+pressure's error at each subsample against a 32-times-finer grid. With --cost, only the WAV's
+cost against the simulation alone, side by side, and the metrics' (issue #31's 3x target).
 
-    python -m gearrattle.sound.bench --fmu FMU [--duration 1] [--set NAME=VALUE ...]"""
+    python -m gearrattle.sound.bench --fmu FMU [--duration 1] [--set NAME=VALUE ...] [--cost]"""
 
 import argparse
 import ctypes
@@ -58,23 +59,53 @@ def alone(unzipdir, md, values, duration):
 
 def reads_alone(unzipdir, md, values, n):
     """CPU of the reads of n steps of meshes.record (the forces at every step, the counters at
-    every WAV sample) without the steps: what calling the FMU from Python costs."""
-    from .meshes import SUBSAMPLE, meshes
+    every WAV sample) without the steps: what calling the FMU's getters from Python costs."""
+    from .meshes import SUBSAMPLE, _raw_calls, meshes
 
     ms = meshes(md, values)
     inst = _initialised(unzipdir, md, values)
     vr_f = (ctypes.c_uint * len(ms))(*[m.force.valueReference for m in ms])
-    vr_c = (ctypes.c_uint * 2)(*[c.valueReference for c in ms[0].counters])
-    F = np.zeros((n, len(ms)))
-    f_mem, c_buf = ctypes.c_double.from_buffer(F), (ctypes.c_int * 2)()
+    vr_c = (ctypes.c_uint * (2 * len(ms)))(*[c.valueReference for m in ms for c in m.counters])
+    F, C = np.zeros((n, len(ms))), np.zeros(len(vr_c), dtype=np.int32)
+    _, get_real, get_int = _raw_calls(inst)
+    vf, vc, comp = ctypes.addressof(vr_f), ctypes.addressof(vr_c), inst.component
+    f_at, c_at = F.ctypes.data, C.ctypes.data
     t0 = time.process_time()
     for k in range(n):
-        inst.fmi2GetReal(inst.component, vr_f, len(ms), ctypes.byref(f_mem, 8 * len(ms) * k))
+        get_real(comp, vf, len(ms), f_at + 8 * len(ms) * k)
         if k % SUBSAMPLE == 0:
-            inst.fmi2GetInteger(inst.component, vr_c, 2, c_buf)
+            get_int(comp, vc, len(vr_c), c_at)
     cpu = time.process_time() - t0
     _free(inst)
     return cpu
+
+
+def cost(fmu, unzip, md, values, duration):
+    """Print the CPU of the simulation alone, of the WAV (the forces sampled, filtered, the mix
+    and stems written) and of the metrics, best of 3 for the first two."""
+    from .meshes import SUBSAMPLE, simulate
+    from .metrics import full_scale, metrics, write_wav
+    from .modal import ModalTransfer
+    from .render import render
+
+    def wav():
+        run = simulate(unzip, md, values, duration)
+        snd = render(run, ModalTransfer(), SUBSAMPLE)
+        scale = full_scale(snd.mix, *snd.stems)
+        with tempfile.TemporaryDirectory() as d:
+            for i, p in enumerate([snd.mix, *snd.stems] if len(snd.stems) > 1 else [snd.mix]):
+                write_wav(os.path.join(d, f"{i}.wav"), p, scale)
+        return run, snd
+
+    t_alone = min(alone(unzip, md, values, duration) for _ in range(3))
+    t_wav, (run, snd) = _cpu(wav)
+    t_met, m = _cpu(metrics, snd.mix, repeat=1)
+    print(f"cost of the sound of {fmu} ({', '.join(f'{k} = {v:g}' for k, v in values.items())}), "
+          f"{duration:g} s simulated, {len(run.forces)} meshes, default modal housing; CPU s")
+    print(f"  {'simulation alone':>16s} {'WAV':>8s} {'ratio':>7s}   {'of the WAV: stepping':>20s} "
+          f"{'filtering':>9s}   {'metrics':>8s}")
+    print(f"  {t_alone:16.3f} {t_wav:8.3f} {t_wav / t_alone:6.0f}x   {run.cpu_s:20.3f} "
+          f"{snd.cpu_s:9.3f}   {t_met:8.3f}")
 
 
 def main(argv=None):
@@ -91,10 +122,14 @@ def main(argv=None):
     ap.add_argument("--fmu", default=os.path.join("target", "fmu", "GearRattle.fmu"))
     ap.add_argument("--duration", type=float, default=1.0)
     ap.add_argument("--set", action="append", default=[], metavar="NAME=VALUE")
+    ap.add_argument("--cost", action="store_true",
+                    help="only the WAV's cost against the simulation alone, and the metrics'")
     a = ap.parse_args(argv)
     md = read_model_description(a.fmu)
     unzip = extract(a.fmu)
     values = start_values(md, dict(parse_set(t, f"--set {t}") for t in a.set))
+    if a.cost:
+        return cost(a.fmu, unzip, md, values, a.duration)
     transfer = ModalTransfer()
     t_alone = min(alone(unzip, md, values, a.duration) for _ in range(3))
     ref = simulate(unzip, md, values, a.duration, subsample=REFERENCE)

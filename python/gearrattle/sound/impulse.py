@@ -29,13 +29,19 @@ class ImpulseResponse:
                              f"of the listening point, e.g. sox {self.path} ir_mono.wav remix 1")
 
     def render(self, force, mesh, subsample):
-        """The pressure at the WAV's instants of one mesh's force sampled subsample times finer."""
+        """The pressure at the WAV's instants of one mesh's force sampled subsample times finer,
+        the force before its first sample held at that sample's value (the housing at rest
+        under it, as in ModalTransfer.pressure)."""
         from scipy.signal import oaconvolve, resample_poly
 
-        f48 = resample_poly(np.asarray(force, dtype=float), 1, subsample)
-        f48 = f48[:len(force[::subsample])]
+        force = np.asarray(force, dtype=float)
+        f48 = resample_poly(force, 1, subsample, padtype="edge")[:len(force[::subsample])]
         h = self.h[:, 0 if self.h.shape[1] == 1 else mesh]
-        return oaconvolve(f48, h)[:len(f48)]
+        p = oaconvolve(f48, h)[:len(f48)]
+        # Σ_{k>n} h[k] F[0]: the held force's share of p[n]
+        tail = (h.sum() - np.cumsum(h))[:len(p)]
+        p[:len(tail)] += force[0] * tail
+        return p
 
     def describe(self):
         return (f"impulse response {self.path} ({self.h.shape[0]} samples at {FS} Hz, "

@@ -1,7 +1,7 @@
 """gearrattle-study listen: the rattle of an FMU run as sound (docs/SOUND.md).
 
     gearrattle-study listen --fmu FMU [--set NAME=VALUE ...] [--transfer modal|MODES.toml|IR.wav]
-                            --duration S --out DIR [--compare --b-set NAME=VALUE ...]
+                            --duration S [--from S] --out DIR [--compare --b-set NAME=VALUE ...]
 
 DIR/rattle.wav (48 kHz, 32-bit float, calibrated in its comment), DIR/gear_<i>.wav per mesh when
 the FMU has several, DIR/impacts.csv (the FMU's impact instants), DIR/spectrogram.png,
@@ -28,6 +28,9 @@ def add_parser(sub):
                    help="modal (the default housing modes), MODES.toml ([[mode]] f, zeta, gain) "
                         "or IR.wav (impulse response in Pa/N at 48 kHz)")
     p.add_argument("--duration", type=float, required=True, help="simulated time [s]")
+    p.add_argument("--from", dest="t_from", type=float, default=0.0, metavar="S",
+                   help="heard from S seconds on (the start-up before it simulated in one "
+                        "step and left out of the sound); default 0")
     p.add_argument("--out", required=True, help="output directory")
     p.add_argument("--compare", action="store_true",
                    help="also run B (the --set values changed by --b-set): DIR/ab.wav and both "
@@ -93,6 +96,8 @@ def listen(a):
         raise ValueError(f"no FMU at {a.fmu}: build it first (make fmu) or give --fmu PATH")
     if not (a.duration > 0 and np.isfinite(a.duration)):
         raise ValueError(f"--duration {a.duration:g}: give a duration > 0 [s]")
+    if not 0 <= a.t_from < a.duration:
+        raise ValueError(f"--from {a.t_from:g}: give 0 <= --from < --duration [s]")
     md = read_model_description(a.fmu)
     transfer = load_transfer(a.transfer)
     todo = scenes(a, md)
@@ -101,7 +106,7 @@ def listen(a):
     os.makedirs(a.out, exist_ok=True)
     done = []
     for label, values in todo:
-        run = simulate(a.fmu, md, values, a.duration)
+        run = simulate(a.fmu, md, values, a.duration, a.t_from)
         done.append((label, run, render(run, transfer, SUBSAMPLE)))
     scale = full_scale(*[s for _, _, snd in done for s in [snd.mix, *snd.stems]])
     files, heard = [], []
@@ -131,11 +136,11 @@ def listen(a):
     path = os.path.join(a.out, "sound.txt")
     with open(path, "w") as fh:
         fh.write("\n".join(lines) + "\n")
-    files += [path, _json(os.path.join(a.out, "sound.json"), transfer, heard, scale)]
+    files += [path, _json(os.path.join(a.out, "sound.json"), a, transfer, heard, scale)]
     return lines, files
 
 
-def _json(path, transfer, heard, scale):
+def _json(path, a, transfer, heard, scale):
     """sound.json: sound.txt's figures for scripts."""
     import json
 
@@ -147,7 +152,8 @@ def _json(path, transfer, heard, scale):
                "cpu_s": {"simulation": run.cpu_s, "filtering": snd.cpu_s, "metrics": m.cpu_s}}
               for label, run, snd, m in heard]
     with open(path, "w") as fh:
-        json.dump({"transfer": transfer.describe(), "full_scale_Pa": scale, "scenes": scenes},
+        json.dump({"duration_s": a.duration, "from_s": a.t_from, "transfer": transfer.describe(),
+                   "full_scale_Pa": scale, "scenes": scenes},
                   fh, indent=1, allow_nan=True)
     return path
 
@@ -174,7 +180,8 @@ def report(a, md, transfer, done, scale):
 
     _, run0, _, _ = done[0]
     h_us = run0.h * 1e6
-    lines = [f"gearrattle-study listen: {a.fmu} (GUID {md.guid}), {a.duration:g} s",
+    heard = f"{a.duration - a.t_from:g} s from {a.t_from:g} s" if a.t_from else f"{a.duration:g} s"
+    lines = [f"gearrattle-study listen: {a.fmu} (GUID {md.guid}), {heard}",
              f"  transfer: {transfer.describe()}",
              f"  meshes: {', '.join(m.force.name for m in run0.meshes)}, sampled every "
              f"{h_us:.3f} us (48 kHz x {SUBSAMPLE}); pressure exact for a force linear "

@@ -18,7 +18,7 @@ every sample, so the only error is the force's deviation from its linear interpo
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.signal import cont2discrete, lfilter, ss2tf
+from scipy.signal import cont2discrete, lfilter, lfilter_zi, ss2tf
 
 
 @dataclass(frozen=True)
@@ -80,14 +80,16 @@ class ModalTransfer:
                                  f"{n_meshes} meshes: give one gain (all meshes) or one per mesh")
 
     def pressure(self, force, mesh, h):
-        """The pressure [Pa] of one mesh's force samples F[n] = F(n h), zero state before."""
+        """The pressure [Pa] of one mesh's force samples F[n] = F(n h), the force before F[0]
+        held at F[0]: the housing starts deflected by it and silent (H(0) = 0), as when a
+        recording starts while a gear rests on its flank."""
         force = np.asarray(force, dtype=float)
         p = np.zeros_like(force)
         for m in self.modes:
             g = m.gain(mesh)
             if g:
                 b, a = foh_coefficients(m, h)
-                p += g * lfilter(b, a, force)
+                p += g * lfilter(b, a, force, zi=lfilter_zi(b, a) * force[:1])[0]
         return p
 
     def render(self, force, mesh, subsample):

@@ -139,8 +139,6 @@ def prepare(st):
     with open(st.fmu, "rb") as f:
         data = f.read()
     model = read_model(st.fmu)
-    gearbox.underlay(st, {n: (v, f"{st.fmu}'s start value")
-                          for n, v in pack.packed_starts(st.fmu, model).items()})
     spec.validate(st, model)
     return model, data
 

@@ -2,19 +2,19 @@
 values are the gearbox of BOX.toml (gearrattle.study.gearbox), so that a drivetrain tool runs
 that gearbox with no setup.
 
-Only the `start` attributes of the named parameters in modelDescription.xml change; every other
-entry of the FMU (binaries, documentation) is copied byte for byte, and so is every other byte
-of the XML. The GUID stays: the binary accepts at fmi2Instantiate only the GUID it was built
-with (fmi2-shell's check_token against Identity.guid), so a new GUID would make the packed FMU
-refuse to instantiate. Two packed FMUs of one build therefore share a GUID; tell them apart by
-their file name.
-
-The binary starts from its built-in defaults and does not read the model description: the
-gearbox runs where the importer sets the parameters from the model description's start values,
-as drivetrain tools do when they show an FMU's parameters (fmpy does so only when given them as
-start_values). An importer that sets no parameter gets the default five-speed box."""
+Only modelDescription.xml changes: the `start` attributes of the named parameters and the GUID
+(FMI 3.0: instantiationToken), every other byte as the generator wrote it; a copy of it goes to
+resources/modelDescription.xml, where the binary finds it also when an importer unpacks only the
+binaries and resources (fmpy's simulate_fmu); every other entry of the FMU (binaries,
+documentation) is copied byte for byte. The GUID is a UUID derived from
+the original's and the box's values, so the same box packed from the same FMU has the same
+GUID and two boxes differ. The binary, given a GUID other than its built-in one, reads the
+model description it ships with and takes its start values if that description names the GUID
+and the binary's variables (fmi2-shell's packed.rs): an importer that sets no parameter runs
+the packed box, and fmi2Reset returns to it."""
 
 import re
+import uuid
 import zipfile
 
 from . import gearbox
@@ -22,24 +22,36 @@ from .errors import StudyError
 from .model import read_model
 
 XML = "modelDescription.xml"
+# The model description's copy among the resources, which every importer unpacks.
+RESOURCE_XML = "resources/" + XML
 
 
 def _start_text(var, value):
-    return str(int(value)) if var.type != "Real" else repr(float(value))
+    return repr(float(value)) if var.type in ("Real", "Float64") else str(int(value))
+
+
+def packed_guid(guid, values):
+    """The GUID of `guid`'s model packed with values {name: (value, where)}: a name-based UUID
+    of both, in the original's braces."""
+    text = guid + "".join(f";{n}={float(v)!r}" for n, (v, _) in sorted(values.items()))
+    return "{" + str(uuid.uuid5(uuid.NAMESPACE_OID, text)) + "}"
 
 
 def rewrite(xml, values, model):
-    """The model description with the start values replaced (text, not a re-serialized tree:
-    attribute order, comments and spacing stay as the generator wrote them)."""
+    """The model description (FMI 2.0 or 3.0) with the start values replaced and the packed
+    GUID (text, not a re-serialized tree: attribute order, comments and spacing stay as the
+    generator wrote them)."""
     for name, (value, where) in values.items():
-        pattern = re.compile(r'(<ScalarVariable name="' + re.escape(name)
-                             + r'"[^>]*>\s*<(?:Real|Integer|Boolean|Enumeration)\b[^>]*?\bstart=")'
-                             r'[^"]*(")')
-        xml, n = pattern.subn(lambda m: m[1] + _start_text(model.parameters[name], value) + m[2],
-                              xml, count=1)
-        if n != 1:
+        n = re.escape(name)
+        pattern = re.compile(r'((?:<ScalarVariable name="' + n + r'"[^>]*>\s*<(?:Real|Integer|'
+                             r'Enumeration)\b|<(?:Float64|Int32|Enumeration) name="' + n
+                             + r'")[^>]*?\bstart=")[^"]*(")')
+        xml, count = pattern.subn(lambda m: m[1] + _start_text(model.parameters[name], value)
+                                  + m[2], xml, count=1)
+        if count != 1:
             raise StudyError(f"{where}: {name} has no start value in {XML} to replace")
-    return xml
+    guid = re.compile(r'(<fmiModelDescription\b[^>]*?\b(?:guid|instantiationToken)=")[^"]*(")')
+    return guid.sub(lambda m: m[1] + packed_guid(model.guid, values) + m[2], xml, count=1)
 
 
 def pack(box, fmu, out):
@@ -51,11 +63,20 @@ def pack(box, fmu, out):
     gearbox.check(values, model)
     with zipfile.ZipFile(fmu) as src:
         xml = rewrite(src.read(XML).decode("utf-8"), values, model)
-        with zipfile.ZipFile(out, "w") as dst:
-            for info in src.infolist():
-                data = xml.encode("utf-8") if info.filename == XML else src.read(info)
-                dst.writestr(info, data)
+    write(fmu, out, xml)
     return model, values
+
+
+def write(fmu, out, xml):
+    """Write out: fmu with the model description xml (text), at its place and in resources/."""
+    with zipfile.ZipFile(fmu) as src, zipfile.ZipFile(out, "w") as dst:
+        for info in src.infolist():
+            if info.filename != RESOURCE_XML:
+                dst.writestr(info, xml.encode("utf-8") if info.filename == XML else src.read(info))
+        md = src.getinfo(XML)
+        copy = zipfile.ZipInfo(RESOURCE_XML, md.date_time)
+        copy.compress_type = md.compress_type
+        dst.writestr(copy, xml.encode("utf-8"))
 
 
 def add_parser(sub):
@@ -71,35 +92,5 @@ def main(a):
     model, values = pack(a.gearbox, a.fmu, a.out)
     if not a.quiet:
         print(f"{a.out}: {a.fmu} with {len(values)} start values of {a.gearbox} "
-              f"(GUID {model.guid}, kept: the binary checks it)")
+              f"(GUID {packed_guid(model.guid, values)})")
     return 0
-
-
-def packed_starts(fmu, model):
-    """{name: start} of the parameters whose start value in the FMU's model description is not
-    the binary's built-in one (a packed FMU's gearbox), read from an instance in initialization
-    mode. The study runner sets them at every point, as a drivetrain tool would."""
-    import shutil
-    import tempfile
-
-    from fmpy import extract
-    from fmpy.fmi2 import FMU2Slave
-
-    path = extract(fmu, unzipdir=tempfile.mkdtemp(prefix="gearrattle-pack-"))
-    try:
-        slave = FMU2Slave(guid=model.guid, unzipDirectory=path,
-                          modelIdentifier=model.model_identifier, instanceName="starts")
-        slave.instantiate()
-        try:
-            slave.setupExperiment(startTime=0.0)
-            slave.enterInitializationMode()
-            real = [v for v in model.parameters.values() if v.type == "Real"]
-            ints = [v for v in model.parameters.values() if v.type != "Real"]
-            built_in = dict(zip((v.name for v in real), slave.getReal([v.vr for v in real])))
-            built_in.update(zip((v.name for v in ints), slave.getInteger([v.vr for v in ints])))
-        finally:
-            slave.freeInstance()
-    finally:
-        shutil.rmtree(path, ignore_errors=True)
-    return {n: v.start for n, v in model.parameters.items()
-            if v.start is not None and built_in[n] != v.start}
