@@ -4,6 +4,7 @@
 //! its `depends_on` (the model description's ModelStructure) says so, and each Model
 //! Exchange state derivative with the states and inputs its `depends_on` names.
 
+use fmi2_shell::Continuous;
 use fmi2_shell::values::Values;
 use gear_rattle::contract::{Causality, Kind, STATES, VARIABLES, Variable, vr};
 use gear_rattle::instance::model_exchange::column;

@@ -17,7 +17,9 @@
 //! - the types of the contract and the checks of a variable's setting ([`contract`]) and, for
 //!   build scripts, the generator of the model description and of the constants from the
 //!   contract TOML (`build`, feature "build"), and the variable tables of the documentation
-//!   ([`table`]); Model Exchange's vectors checked ([`vectors`]).
+//!   ([`table`]);
+//! - Model Exchange's vectors: a model's continuous part ([`Continuous`]) and the checks of
+//!   the importer's arrays against it ([`vectors`]).
 
 #[cfg(feature = "build")]
 pub mod build;
@@ -51,3 +53,4 @@ pub use log::{Log, Message};
 pub use slave::{EventInfo, Identity, Interface, Slave};
 pub use state::FmiState;
 pub use status::{FmiError, FmiResult, Status};
+pub use vectors::Continuous;

@@ -182,7 +182,7 @@ macro_rules! export_model_exchange {
         $crate::exports! { mod fmi2_model_exchange_exports for $slave; use $crate::fmi2, $crate::state::allowed; {}
             fn fmi2SetTime(time: fmi2Real) SET_TIME |s| s.set_time(time);
             fn fmi2SetContinuousStates(x: *const fmi2Real, nx: usize)
-                SET_CONTINUOUS_STATES |s| s.slave.set_continuous_states(array!(x, nx));
+                SET_CONTINUOUS_STATES |s| s.set_continuous_states(array!(x, nx));
             fn fmi2EnterEventMode() ENTER_EVENT_MODE |s| s.enter_event_mode();
             fn fmi2NewDiscreteStates(info: *mut fmi2EventInfo) NEW_DISCRETE_STATES |s| {
                 let Some(out) = (unsafe { info.as_mut() }) else {
@@ -206,13 +206,13 @@ macro_rules! export_model_exchange {
                     Ok(())
                 };
             fn fmi2GetDerivatives(derivatives: *mut fmi2Real, nx: usize) GET_CONTINUOUS
-                |s| s.slave.get_derivatives(array!(mut derivatives, nx));
+                |s| s.get_derivatives(array!(mut derivatives, nx));
             fn fmi2GetEventIndicators(eventIndicators: *mut fmi2Real, ni: usize) GET_CONTINUOUS
-                |s| s.slave.get_event_indicators(array!(mut eventIndicators, ni));
+                |s| s.get_event_indicators(array!(mut eventIndicators, ni));
             fn fmi2GetContinuousStates(x: *mut fmi2Real, nx: usize) GET_CONTINUOUS
-                |s| s.slave.get_continuous_states(array!(mut x, nx));
+                |s| s.get_continuous_states(array!(mut x, nx));
             fn fmi2GetNominalsOfContinuousStates(x_nominal: *mut fmi2Real, nx: usize) GET_CONTINUOUS
-                |s| s.slave.get_nominals_of_continuous_states(array!(mut x_nominal, nx));
+                |s| s.get_nominals_of_continuous_states(array!(mut x_nominal, nx));
         }
     };
 }

@@ -7,6 +7,7 @@ use crate::contract::{Kind, Variable, no_variables};
 use crate::log::{Categories, Log};
 use crate::state::FmiState;
 use crate::status::{FmiError, FmiResult};
+use crate::vectors::{Continuous, NoContinuous};
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 
@@ -177,24 +178,10 @@ pub trait Slave: Clone + Serialize + DeserializeOwned {
         Err(unsupported("fmi2SetTime"))
     }
 
-    fn set_continuous_states(&mut self, _x: &[f64]) -> FmiResult {
-        Err(unsupported("fmi2SetContinuousStates"))
-    }
-
-    fn get_continuous_states(&mut self, _x: &mut [f64]) -> FmiResult {
-        Err(unsupported("fmi2GetContinuousStates"))
-    }
-
-    fn get_nominals_of_continuous_states(&mut self, _x: &mut [f64]) -> FmiResult {
-        Err(unsupported("fmi2GetNominalsOfContinuousStates"))
-    }
-
-    fn get_derivatives(&mut self, _dx: &mut [f64]) -> FmiResult {
-        Err(unsupported("fmi2GetDerivatives"))
-    }
-
-    fn get_event_indicators(&mut self, _z: &mut [f64]) -> FmiResult {
-        Err(unsupported("fmi2GetEventIndicators"))
+    /// The continuous part whose states, nominals, derivatives and event indicators the
+    /// shell reads and sets ([`Continuous`]; the arrays' checks are the shell's).
+    fn continuous(&mut self) -> FmiResult<&mut impl Continuous> {
+        Err::<&mut NoContinuous, _>(unsupported("Model Exchange"))
     }
 
     /// fmi2NewDiscreteStates, in event mode.

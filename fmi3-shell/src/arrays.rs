@@ -185,18 +185,19 @@ fn states_length(order: &[usize], n: usize) -> FmiResult {
     }
 }
 
-/// One of the slave's state-sized vectors (`read` fills it) in FMI 3.0's order.
+/// One of the model's state-sized vectors (`read` fills it, fmi2-shell's checks) in FMI
+/// 3.0's order.
 pub fn gather<S: Slave>(
     fmu: &mut Fmu<S>,
     arrays: &[Array],
     states: &[u32],
     out: &mut [f64],
-    read: impl FnOnce(&mut S, &mut [f64]) -> FmiResult,
+    read: impl FnOnce(&mut Fmu<S>, &mut [f64]) -> FmiResult,
 ) -> FmiResult {
     let order = state_order(fmu, arrays, states)?;
     states_length(&order, out.len())?;
     let mut all = vec![0.0; states.len()];
-    read(&mut fmu.slave, &mut all)?;
+    read(fmu, &mut all)?;
     for (out, &i) in out.iter_mut().zip(&order) {
         *out = all[i];
     }
@@ -214,11 +215,11 @@ pub fn set_continuous_states<S: Slave>(
     let order = state_order(fmu, arrays, states)?;
     states_length(&order, x.len())?;
     let mut all = vec![0.0; states.len()];
-    fmu.slave.get_continuous_states(&mut all)?;
+    fmu.get_continuous_states(&mut all)?;
     for (&x, &i) in x.iter().zip(&order) {
         all[i] = x;
     }
-    fmu.slave.set_continuous_states(&all)
+    fmu.set_continuous_states(&all)
 }
 
 #[cfg(test)]

@@ -196,7 +196,7 @@ pub fn get_float64<S: Slave>(
             _ if vr >= EVENT_INDICATOR_VR && k < indicators => {
                 if z.is_none() {
                     let mut values = vec![0.0; indicators];
-                    fmu.slave.get_event_indicators(&mut values)?;
+                    fmu.get_event_indicators(&mut values)?;
                     z = Some(values);
                 }
                 z.as_ref().expect("computed")[k]

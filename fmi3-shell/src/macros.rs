@@ -277,15 +277,15 @@ macro_rules! __fmi3_exports {
                 |s| ar::set_continuous_states(s, contract::FMI3_ARRAYS, contract::STATES, array!(x, nx));
             fn fmi3GetContinuousStateDerivatives(derivatives: *mut fmi3Float64, nx: usize) GET_CONTINUOUS
                 |s| ar::gather(s, contract::FMI3_ARRAYS, contract::STATES, array!(mut derivatives, nx),
-                    |slave, v| slave.get_derivatives(v));
+                    |fmu, v| fmu.get_derivatives(v));
             fn fmi3GetEventIndicators(eventIndicators: *mut fmi3Float64, ni: usize) GET_CONTINUOUS
-                |s| s.slave.get_event_indicators(array!(mut eventIndicators, ni));
+                |s| s.get_event_indicators(array!(mut eventIndicators, ni));
             fn fmi3GetContinuousStates(x: *mut fmi3Float64, nx: usize) GET_CONTINUOUS
                 |s| ar::gather(s, contract::FMI3_ARRAYS, contract::STATES, array!(mut x, nx),
-                    |slave, v| slave.get_continuous_states(v));
+                    |fmu, v| fmu.get_continuous_states(v));
             fn fmi3GetNominalsOfContinuousStates(nominals: *mut fmi3Float64, nx: usize) GET_CONTINUOUS
                 |s| ar::gather(s, contract::FMI3_ARRAYS, contract::STATES, array!(mut nominals, nx),
-                    |slave, v| slave.get_nominals_of_continuous_states(v));
+                    |fmu, v| fmu.get_nominals_of_continuous_states(v));
             fn fmi3GetNumberOfEventIndicators(n: *mut usize) GET_NUMBER_OF
                 |_| unsafe { e3::number(n, contract::EVENT_INDICATORS) };
             fn fmi3GetNumberOfContinuousStates(n: *mut usize) GET_NUMBER_OF

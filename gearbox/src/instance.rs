@@ -6,13 +6,11 @@
 use serde::{Deserialize, Serialize};
 
 use crate::contract::{self, Causality, Kind, LOG_CATEGORIES, VARIABLES, vr};
-use crate::model_exchange::NX;
 use crate::outputs::Now;
 use crate::simulation::{self, Simulation};
 use fmi2_shell::values::Values;
-use fmi2_shell::vectors::{fill, states};
 use fmi2_shell::{
-    EventInfo, FmiError, FmiResult, FmiState, Identity, Interface, Log, Slave, Status,
+    Continuous, EventInfo, FmiError, FmiResult, FmiState, Identity, Interface, Log, Slave, Status,
 };
 
 /// The contract's log categories by role (errors and warnings first, as the shell wants).
@@ -333,26 +331,9 @@ impl Slave for Instance {
         Ok(())
     }
 
-    fn set_continuous_states(&mut self, x: &[f64]) -> FmiResult {
-        let x = states::<NX>(x)?;
-        self.sim_mut().set_continuous_states(x);
-        Ok(())
-    }
-
-    fn get_continuous_states(&mut self, x: &mut [f64]) -> FmiResult {
-        fill("x", x, self.current()?.continuous_states())
-    }
-
-    fn get_nominals_of_continuous_states(&mut self, x: &mut [f64]) -> FmiResult {
-        fill("x_nominal", x, self.current()?.nominals())
-    }
-
-    fn get_derivatives(&mut self, dx: &mut [f64]) -> FmiResult {
-        fill("derivatives", dx, self.current()?.derivatives())
-    }
-
-    fn get_event_indicators(&mut self, z: &mut [f64]) -> FmiResult {
-        fill("eventIndicators", z, self.current()?.event_indicators())
+    fn continuous(&mut self) -> FmiResult<&mut impl Continuous> {
+        self.current()?;
+        Ok(self.sim_mut())
     }
 
     fn new_discrete_states(&mut self) -> FmiResult<EventInfo> {

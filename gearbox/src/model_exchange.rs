@@ -16,6 +16,7 @@
 use crate::contract::{EVENT_INDICATORS, STATES};
 use crate::simulation::{Run, Simulation};
 use crate::windowed;
+use fmi2_shell::Continuous;
 use gear_rattle::gearbox::{Drive, Gearbox, MAX_GEARS, PHI, PHI_DOT, State, xi, xi_dot};
 use gear_rattle::integrator::{Piecewise, System};
 use gear_rattle::physics::{Polynomial, Region, Shaft};
@@ -34,9 +35,12 @@ const fn x_xi(i: usize) -> usize {
     2 + 2 * i
 }
 
-impl Simulation {
+impl Continuous for Simulation {
+    type States = [f64; NX];
+    type Indicators = [f64; NZ];
+
     /// The continuous states x.
-    pub fn continuous_states(&self) -> [f64; NX] {
+    fn continuous_states(&self) -> [f64; NX] {
         let (g, y) = self.gearbox();
         let mut x = [0.0; NX];
         if !matches!(g.drive, Drive::InputSide(_)) {
@@ -50,7 +54,7 @@ impl Simulation {
     }
 
     /// Takes the importer's states x: φ' follows from ω_I and the flywheel's speed now.
-    pub fn set_continuous_states(&mut self, x: &[f64; NX]) {
+    fn set_continuous_states(&mut self, x: &[f64; NX]) {
         self.change_state(|g, t, y| {
             if !matches!(g.drive, Drive::InputSide(_)) {
                 y[PHI] = x[X_PHI];
@@ -62,17 +66,8 @@ impl Simulation {
         });
     }
 
-    /// The gearbox at the current states, with the stage and regions they are in (a copy:
-    /// the kept ones change at events only).
-    pub(crate) fn settled(&self) -> (Gearbox, State) {
-        let (g, y) = self.gearbox();
-        let mut g = *g;
-        g.settle(self.t, &y);
-        (g, y)
-    }
-
     /// dx/dt at the current time and states, with the formulas of the pieces they are in.
-    pub fn derivatives(&self) -> [f64; NX] {
+    fn derivatives(&self) -> [f64; NX] {
         let (g, y) = self.settled();
         let f = g.rhs(self.t, &y);
         let mut dx = [0.0; NX];
@@ -88,7 +83,7 @@ impl Simulation {
 
     /// Nominal magnitudes: φ on the scale of φ_1, ω_I of 100 rad/s, each ξ of its backlash
     /// and ξ' of a backlash per millisecond.
-    pub fn nominals(&self) -> [f64; NX] {
+    fn nominals(&self) -> [f64; NX] {
         let (g, _) = self.gearbox();
         let mut x = [1.0; NX];
         (x[X_PHI], x[X_OMEGA_I]) = (g.damper.params.phi_1, 100.0);
@@ -101,7 +96,7 @@ impl Simulation {
 
     /// The event indicators (see the module's documentation); constant 1 for the slots of
     /// gears the box does not have, and for the damper when the input side is driven.
-    pub fn event_indicators(&self) -> [f64; NZ] {
+    fn event_indicators(&self) -> [f64; NZ] {
         let (g, y) = self.gearbox();
         let mut z = [1.0; NZ];
         for (i, gear) in g.gears[..g.n_gears()].iter().enumerate() {
@@ -124,6 +119,17 @@ impl Simulation {
             z[NZ - 2..].copy_from_slice(&[y[PHI] - phi_1, y[PHI] + phi_1]);
         }
         z
+    }
+}
+
+impl Simulation {
+    /// The gearbox at the current states, with the stage and regions they are in (a copy:
+    /// the kept ones change at events only).
+    pub(crate) fn settled(&self) -> (Gearbox, State) {
+        let (g, y) = self.gearbox();
+        let mut g = *g;
+        g.settle(self.t, &y);
+        (g, y)
     }
 
     /// The importer's time: the states x stay as set (φ' follows the flywheel's speed).

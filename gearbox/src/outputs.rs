@@ -7,6 +7,7 @@ use crate::contract::vr::{self, gear::offset};
 use crate::contract::{DERIVATIVES, STATES};
 use crate::simulation::Simulation;
 use crate::windowed;
+use fmi2_shell::Continuous;
 use gear_rattle::gearbox::{Gearbox, Readout};
 use gear_rattle::rattle::window::Metrics;
 

@@ -4,7 +4,7 @@
 //! description's ModelStructure); so does each state derivative.
 
 use fmi2_shell::values::Values;
-use fmi2_shell::{Fmu, Interface, Slave};
+use fmi2_shell::{Continuous, Fmu, Interface, Slave};
 use gearbox_rattle::contract::{self, Causality, Kind, STATES, VARIABLES, Variable, vr};
 use gearbox_rattle::instance::Instance;
 use gearbox_rattle::simulation::{self, Simulation};

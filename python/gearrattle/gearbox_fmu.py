@@ -8,6 +8,8 @@ import pathlib
 
 import numpy as np
 
+from . import fmpy_run
+
 ROOT = pathlib.Path(__file__).resolve().parents[2]  # the repository (python/gearrattle/..)
 GEARBOX_FMU = ROOT / "target" / "fmu" / "GearboxRattle.fmu"
 
@@ -32,37 +34,9 @@ def outputs(n_gears: int, gear_fields=GEAR_OUTPUTS) -> list:
 def simulate(fmu, t_end: float, dt: float = 1e-4, fmi_type: str = "CoSimulation", tol: float | None = None,
              inputs=None, gear_fields=GEAR_OUTPUTS, model_description=None, **start):
     """Run the box from 0 to t_end with the start values `start` (contract names, an int sets
-    an Integer), outputs every dt; `fmu` a path or an extracted directory. Co-Simulation:
-    communication step dt, `tol` to fmi2SetupExperiment; Model Exchange: fmpy's CVode at the
-    relative tolerance `tol`, output every dt (the rows fmpy adds at events left out).
-    inputs: fmpy's structured input array."""
-    from fmpy import simulate_fmu
-
+    an Integer), its outputs and each gear's `gear_fields` every dt (see fmpy_run.simulate)."""
     n = int(start.get("n_gears", 5))
-    res = simulate_fmu(
-        str(fmu),
-        model_description=model_description,
-        fmi_type=fmi_type,
-        solver="CVode",
-        start_time=0.0,
-        stop_time=t_end,
-        start_values=start,
-        input=inputs,
-        step_size=dt,
-        output_interval=dt,
-        relative_tolerance=tol,
-        output=outputs(n, gear_fields),
-    )
-    return res if fmi_type == "CoSimulation" else on_grid(res, dt)
-
-
-def on_grid(result, dt: float):
-    """The rows of `result` at the output times k dt, the last one where an event repeats a
-    time."""
-    k = result["time"] / dt
-    on = np.abs(k - np.round(k)) < 1e-6
-    last = np.append(result["time"][1:] != result["time"][:-1], True)
-    return result[on & last]
+    return fmpy_run.simulate(fmu, t_end, dt, outputs(n, gear_fields), fmi_type, tol, inputs, model_description, **start)
 
 
 def per_gear(result, field: str) -> np.ndarray:

@@ -56,9 +56,9 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.integrate import DOP853, Radau, quad
-from scipy.optimize import brentq
+from scipy.integrate import quad
 
+from gearrattle.piecewise import SOLVERS, Outputs, edge_in_step, output_grid, output_times, step
 from gearrattle.reference import FMINUS, FPLUS, _contact, _regions, contact_force
 
 # docs/GEARBOX.md §6, per gear: (ratio r_L/r_M, r_M, r_L, I_L, G, C_LM, C at 40 °C)
@@ -122,9 +122,6 @@ SCENES = {
 # Damper stage codes: -1 main stage (phi < -phi_1), 0 pre-damper, +1 main stage (phi > phi_1).
 IDLE = 0
 
-_SOLVERS = {"DOP853": DOP853, "Radau": Radau}
-_BRENT_RTOL = 4.0 * np.finfo(float).eps
-_XTOL = 1e-16
 _TWO_PI = 2.0 * math.pi
 
 
@@ -441,19 +438,14 @@ def simulate(
     switches += [(lay.xi + i, lay.xi_dot + i, _regions(g)) for i, g in enumerate(gears)]
     region = [next(k for k, (_, lo, hi) in enumerate(reg) if lo <= y[ix] <= hi) for ix, _, reg in switches]
 
-    t_eval = np.array([0.0, t_end]) if t_eval is None else np.asarray(t_eval, dtype=float)
-    if t_eval.size and (t_eval[0] < 0.0 or t_eval[-1] > t_end * (1 + 1e-12) or np.any(np.diff(t_eval) < 0)):
-        raise ValueError("t_eval must be increasing within [0, t_end]")
-    out = np.full((lay.size, t_eval.size), np.nan)
-    k_out = 0
-    while k_out < t_eval.size and t_eval[k_out] <= 0.0:
-        out[:, k_out] = y
-        k_out += 1
+    t_eval = output_times(t_eval, 0.0, t_end)
+    outputs = Outputs(t_eval, lay.size)
+    outputs.fill(0.0, lambda _t: y)
 
     impacts = [dict(t=[], flank=[], speed=[]) for _ in gears]
     stage_t, stage = [0.0], [damper_regions[region[0]][0]]
     nfev = nsteps = npieces = stalls = 0
-    solver_cls = _SOLVERS[method]
+    solver_cls = SOLVERS[method]
     t = 0.0
     while t < t_end:
         codes = tuple(switches[j][2][region[j]][0] for j in range(1, n + 1))
@@ -463,23 +455,19 @@ def simulate(
         crossing = None  # (t, switch, side)
         while True:
             t_old, y_old = solver.t, solver.y.copy()
-            msg = solver.step()
-            if solver.status == "failed":
-                raise RuntimeError(f"{method} failed at t={solver.t}: {msg}")
+            step(solver)
             nsteps += 1
             t_new, y_new = solver.t, solver.y
             dense = None
             for j, (ix, iv, reg) in enumerate(switches):
                 _, lo, hi = reg[region[j]]
-                found, dense = _edge_in_step(solver, dense, ix, iv, lo, hi, t_old, y_old, y_new)
+                found, dense, _ = edge_in_step(solver, dense, ix, iv, lo, hi, t_old, y_old, y_new)
                 if found is not None and (crossing is None or found[0] < crossing[0]):
                     crossing = (found[0], j, found[1])
             t_lim = t_new if crossing is None else crossing[0]
-            if k_out < t_eval.size and t_eval[k_out] <= t_lim:
+            if outputs.due(t_lim):
                 dense = dense or solver.dense_output()
-                while k_out < t_eval.size and t_eval[k_out] <= t_lim:
-                    out[:, k_out] = dense(t_eval[k_out])
-                    k_out += 1
+                outputs.fill(t_lim, dense)
             if crossing is not None or solver.status == "finished":
                 break
         nfev += solver.nfev
@@ -506,11 +494,9 @@ def simulate(
             d["speed"].append(abs(y[lay.xi_dot + j - 1]))
         region[j] += side
 
-    while k_out < t_eval.size:
-        out[:, k_out] = y
-        k_out += 1
+    outputs.fill(math.inf, lambda _t: y)
 
-    n_t = t_eval.size
+    out, n_t = outputs.values, t_eval.size
     quads = dict(
         W_F=out[lay.W_F],
         D_damper=out[lay.D_damper],
@@ -554,44 +540,11 @@ def _reach(solver_cls, rhs, t0, y0, t1, rtol, atol):
     return np.array(solver.y), solver.nfev
 
 
-def _edge_in_step(solver, dense, ix, iv, lo, hi, t_old, y_old, y_new):
-    """The first crossing of lo or hi by y[ix] within the solver's last step (from t_old,
-    y_old to solver.t, y_new), as ((t_c, side), dense) with side -1 (lo) or +1 (hi), or
-    (None, dense). A turning point of y[ix] inside the step (its rate y[iv] changes sign) is
-    located and checked as well; `dense` is the step's dense output, computed here only
-    when needed and handed back."""
-    t_from, t_new = t_old, solver.t
-    if y_old[iv] * y_new[iv] < 0.0:
-        dense = dense or solver.dense_output()
-        t_turn = brentq(lambda s: dense(s)[iv], t_old, t_new, xtol=_XTOL, rtol=_BRENT_RTOL)
-        x_turn = dense(t_turn)[ix]
-        if x_turn < lo:
-            return (_root(dense, ix, lo, t_old, t_turn), -1), dense
-        if x_turn > hi:
-            return (_root(dense, ix, hi, t_old, t_turn), 1), dense
-        t_from = t_turn
-    x_new = y_new[ix]
-    if lo <= x_new <= hi:
-        return None, dense
-    dense = dense or solver.dense_output()
-    edge, side = (lo, -1) if x_new < lo else (hi, 1)
-    return (_root(dense, ix, edge, t_from, t_new), side), dense
-
-
-def _root(dense, ix, edge, a, b):
-    fa = dense(a)[ix] - edge
-    if fa == 0.0:
-        return a
-    return brentq(lambda s: dense(s)[ix] - edge, a, b, xtol=_XTOL, rtol=_BRENT_RTOL)
-
-
 @functools.lru_cache(maxsize=None)
 def scene(name: str, t_end: float, dt_out: float, method: str = "DOP853", rtol: float = 1e-12) -> Result:
     """A scene of SCENES with the defaults, outputs every dt_out (i * dt_out), cached for
     the tests of one session."""
-    t_eval = np.arange(int(round(t_end / dt_out)) + 1) * dt_out
-    t_eval[-1] = min(t_eval[-1], t_end)
-    return simulate(params(name), t_end, t_eval=t_eval, method=method, rtol=rtol)
+    return simulate(params(name), t_end, t_eval=output_grid(t_end, dt_out), method=method, rtol=rtol)
 
 
 # ----------------------------------------------------------------------------------------

@@ -30,7 +30,9 @@ ends exactly on a band edge (xi = -eps, 0, G, G+eps; only the two edges bounding
 current region are watched). The steps are driven by hand with scipy's OdeSolver classes
 (DOP853, or Radau as an independent second method) so that an edge crossed and recrossed
 inside one step (a grazing touch: xi_dot changes sign within the step) is not skipped:
-the extremum is located on the dense output and checked against the edges.
+the extremum is located on the dense output and checked against the edges. That numerical
+side (the solvers, the outputs, the edge search) is `gearrattle.piecewise`, shared with the
+gearbox's reference.
 
 Impacts are contact onsets (docs/MODEL.md §1): the gap left downwards through 0 (flank F+) or
 upwards through G (flank F-); recorded with time, flank and |xi_dot|.
@@ -43,8 +45,8 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.integrate import DOP853, Radau
-from scipy.optimize import brentq
+
+from gearrattle.piecewise import SOLVERS, Outputs, edge_in_step, output_grid, output_times, step
 
 # The paper's parameters (docs/MODEL.md §4) and the FMU's defaults (modelDescription/GearRattle.toml).
 DEFAULTS = dict(
@@ -78,9 +80,7 @@ SCENES = {
 FPLUS = 1
 FMINUS = 2
 
-_SOLVERS = {"DOP853": DOP853, "Radau": Radau}
 _TWO_PI = 2.0 * math.pi
-_BRENT_RTOL = 4.0 * np.finfo(float).eps
 
 
 def params(scene: str | None = None, **overrides) -> dict:
@@ -324,16 +324,11 @@ def _piecewise(p, rhs_for, y0, atol, t_start, t_end, t_eval, method, rtol, break
     right-hand side may jump (a torque held over a communication step). Returns the fields of
     a result: t, out (the state at the times t_eval, one row per component), the impacts, the
     extremes of xi, counters and final_y."""
-    solver_cls = _SOLVERS[method]
-    if t_eval is None:
-        t_eval = np.array([t_start, t_end])
-    t_eval = np.asarray(t_eval, dtype=float)
-    if t_eval.size and (t_eval[0] < t_start or t_eval[-1] > t_end * (1 + 1e-12) or np.any(np.diff(t_eval) < 0)):
-        raise ValueError("t_eval must be increasing within [t_start, t_end]")
+    solver_cls = SOLVERS[method]
+    t_eval = output_times(t_eval, t_start, t_end)
     breaks = np.asarray(breaks, dtype=float)
     y = np.array(y0, dtype=float)
-    out = np.full((y.size, t_eval.size), np.nan)
-    k_out = 0  # next output index
+    outputs = Outputs(t_eval, y.size)
 
     regions = _regions(p)
 
@@ -341,16 +336,12 @@ def _piecewise(p, rhs_for, y0, atol, t_start, t_end, t_eval, method, rtol, break
     xi0 = y[0]
     idx = next(i for i, (_, lo, hi) in enumerate(regions) if lo <= xi0 <= hi)
     t = t_start
-    # outputs at t_start
-    while k_out < t_eval.size and t_eval[k_out] <= t_start:
-        out[:, k_out] = y
-        k_out += 1
+    outputs.fill(t_start, lambda _t: y)
 
     imp_t, imp_fl, imp_v, imp_x = [], [], [], []
     xi_min = xi_max = xi0
     nfev = nsteps = npieces = 0
     stalls = 0
-    xtol = 1e-16
     piece_min = piece_max = xi0  # extremes of xi in the current region (across breaks)
 
     while t < t_end:
@@ -363,57 +354,33 @@ def _piecewise(p, rhs_for, y0, atol, t_start, t_end, t_eval, method, rtol, break
         crossing = None  # (t_event, y_event, +1 upper / -1 lower)
         while True:
             t_old, y_old = solver.t, solver.y
-            msg = solver.step()
-            if solver.status == "failed":
-                raise RuntimeError(f"{method} failed at t={solver.t}: {msg}")
+            step(solver)
             nsteps += 1
             t_new, y_new = solver.t, solver.y
-            x_new = y_new[0]
-            dense = None
-            tc, side = None, 0
-            t_from = t_old  # start of the root search for a crossing at the step's end
-            # a turning point inside the step may hide an excursion past an edge (grazing)
-            v_old, v_new = y_old[1], y_new[1]
-            if (v_old > 0.0 and v_new < 0.0) or (v_old < 0.0 and v_new > 0.0):
-                dense = solver.dense_output()
-                t_turn = brentq(lambda s: dense(s)[1], t_old, t_new, xtol=xtol, rtol=_BRENT_RTOL)
-                x_turn = dense(t_turn)[0]
-                if x_turn < lo:
-                    tc, side = _root(dense, lo, t_old, t_turn, xtol), -1
-                elif x_turn > hi:
-                    tc, side = _root(dense, hi, t_old, t_turn, xtol), 1
-                else:
-                    t_from = t_turn  # xi monotonic on [t_turn, t_new]
-                    xi_min = min(xi_min, x_turn)
-                    xi_max = max(xi_max, x_turn)
-                    piece_min = min(piece_min, x_turn)
-                    piece_max = max(piece_max, x_turn)
-            # crossing of an edge at the step's end
-            if tc is None:
-                if x_new < lo:
-                    side = -1
-                elif x_new > hi:
-                    side = 1
-                if side != 0:
-                    dense = dense or solver.dense_output()
-                    tc = _root(dense, lo if side < 0 else hi, t_from, t_new, xtol)
-            if tc is not None:
+            # an edge crossed within the step, or past a turning point inside it (grazing)
+            found, dense, x_turn = edge_in_step(solver, None, 0, 1, lo, hi, t_old, y_old, y_new)
+            if x_turn is not None:
+                xi_min = min(xi_min, x_turn)
+                xi_max = max(xi_max, x_turn)
+                piece_min = min(piece_min, x_turn)
+                piece_max = max(piece_max, x_turn)
+            if found is not None:
+                tc, side = found
                 y_c = dense(tc)
                 y_c[0] = lo if side < 0 else hi
                 t_lim = tc
             else:
+                x_new = y_new[0]
                 t_lim = t_new
                 xi_min = min(xi_min, x_new)
                 xi_max = max(xi_max, x_new)
                 piece_min = min(piece_min, x_new)
                 piece_max = max(piece_max, x_new)
             # outputs inside (t_old, t_lim]
-            if k_out < t_eval.size and t_eval[k_out] <= t_lim:
+            if outputs.due(t_lim):
                 dense = dense or solver.dense_output()
-                while k_out < t_eval.size and t_eval[k_out] <= t_lim:
-                    out[:, k_out] = dense(t_eval[k_out])
-                    k_out += 1
-            if tc is not None:
+                outputs.fill(t_lim, dense)
+            if found is not None:
                 crossing = (tc, y_c, side)
                 break
             if solver.status == "finished":
@@ -440,13 +407,11 @@ def _piecewise(p, rhs_for, y0, atol, t_start, t_end, t_eval, method, rtol, break
         piece_min = piece_max = y[0]
 
     # outputs exactly at t_end that may remain (t_eval[-1] == t_end rounding)
-    while k_out < t_eval.size:
-        out[:, k_out] = y
-        k_out += 1
+    outputs.fill(math.inf, lambda _t: y)
 
     return dict(
         t=t_eval,
-        out=out,
+        out=outputs.values,
         impact_t=np.array(imp_t),
         impact_flank=np.array(imp_fl, dtype=int),
         impact_speed=np.array(imp_v),
@@ -570,13 +535,6 @@ def simulate_torque(
     )
 
 
-def _root(dense, edge, a, b, xtol):
-    fa = dense(a)[0] - edge
-    if fa == 0.0:
-        return a
-    return brentq(lambda s: dense(s)[0] - edge, a, b, xtol=xtol, rtol=_BRENT_RTOL)
-
-
 # ----------------------------------------------------------------------------------------
 # Cached scene runs (shared by the tests of one pytest session)
 # ----------------------------------------------------------------------------------------
@@ -585,11 +543,7 @@ def _root(dense, edge, a, b, xtol):
 @functools.lru_cache(maxsize=None)
 def scene(name: str, t_end: float, dt_out: float | None = None, method: str = "DOP853", rtol: float = 1e-12) -> Result:
     """Run a bench scene (S1, S2, S3) with the defaults, outputs every dt_out (i * dt_out)."""
-    t_eval = None
-    if dt_out is not None:
-        n = int(round(t_end / dt_out))
-        t_eval = np.arange(n + 1) * dt_out
-        t_eval[-1] = min(t_eval[-1], t_end)
+    t_eval = None if dt_out is None else output_grid(t_end, dt_out)
     return simulate(params(name), t_end, t_eval=t_eval, method=method, rtol=rtol)
 
 

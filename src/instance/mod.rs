@@ -14,9 +14,8 @@ use crate::contract::{self, Causality, Kind, LOG_CATEGORIES, vr};
 use crate::physics::Shaft;
 use crate::rattle::Impacts;
 use fmi2_shell::values::Values;
-use fmi2_shell::vectors::{fill, states};
-use fmi2_shell::{EventInfo, Identity, Interface, Log, Slave};
-use model_exchange::NX;
+use fmi2_shell::{Continuous, EventInfo, Identity, Interface, Log, Slave};
+
 use serde::{Deserialize, Serialize};
 
 /// The contract's log categories by role (errors and warnings first, as the shell wants).
@@ -552,26 +551,9 @@ impl Slave for Instance {
         })
     }
 
-    fn set_continuous_states(&mut self, x: &[f64]) -> FmiResult {
-        let x = states::<NX>(x)?;
-        self.model_exchange().set_continuous_states(x);
-        Ok(())
-    }
-
-    fn get_continuous_states(&mut self, x: &mut [f64]) -> FmiResult {
-        fill("x", x, self.current()?.continuous_states())
-    }
-
-    fn get_nominals_of_continuous_states(&mut self, x: &mut [f64]) -> FmiResult {
-        fill("x_nominal", x, self.current()?.nominals())
-    }
-
-    fn get_derivatives(&mut self, dx: &mut [f64]) -> FmiResult {
-        fill("derivatives", dx, self.current()?.derivatives())
-    }
-
-    fn get_event_indicators(&mut self, z: &mut [f64]) -> FmiResult {
-        fill("eventIndicators", z, self.current()?.event_indicators())
+    fn continuous(&mut self) -> FmiResult<&mut impl Continuous> {
+        self.current()?;
+        Ok(self.model_exchange())
     }
 
     fn new_discrete_states(&mut self) -> FmiResult<EventInfo> {

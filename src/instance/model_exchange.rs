@@ -25,6 +25,7 @@ use super::simulation::{Drive, Gear, Simulation, by_coupling, on_gear};
 use crate::physics::{Dynamics, Excitation, Loads, MainShaft, Polynomial, Region, Shaft};
 use crate::rattle::window::quadrature;
 use crate::rattle::{GearPair, XI, XI_DOT, quadrature_rates, torque};
+use fmi2_shell::Continuous;
 
 /// Number of continuous states.
 pub const NX: usize = 4 + quadrature::COUNT;
@@ -62,9 +63,12 @@ fn nominals(G: f64) -> [f64; NX] {
     [G, 10.0, 1.0, 10.0, 1e-3, 1e-2, 1e-2, 1e2, 1.0, 1e2]
 }
 
-impl Simulation {
+impl Continuous for Simulation {
+    type States = [f64; NX];
+    type Indicators = [f64; NZ];
+
     /// The continuous states x.
-    pub fn continuous_states(&self) -> [f64; NX] {
+    fn continuous_states(&self) -> [f64; NX] {
         let now = self.now();
         let mut x = [0.0; NX];
         (x[0], x[1]) = (now.xi, now.loads(&self.shaft()).omega_L);
@@ -76,7 +80,7 @@ impl Simulation {
 
     /// Takes the importer's states x: ξ' follows from ω_L and the shaft's speed now. (Model
     /// Exchange's simulation carries every quadrature, [`Carry::All`](super::Carry::All).)
-    pub fn set_continuous_states(&mut self, x: &[f64; NX]) {
+    fn set_continuous_states(&mut self, x: &[f64; NX]) {
         let t = self.t;
         by_coupling!(&mut self.gear, kinematic k => {
             let p = &k.system.dynamics.params;
@@ -95,6 +99,50 @@ impl Simulation {
         })
     }
 
+    /// dx/dt at the current time and states, with the formula of the region ξ is in: the
+    /// contact force is continuous with a continuous slope across the edges (docs/MODEL.md §2),
+    /// so the importer's solver sees a smooth enough right-hand side wherever its trial
+    /// points fall, also past an edge it has not located yet.
+    fn derivatives(&self) -> [f64; NX] {
+        let Point {
+            dynamics,
+            loads,
+            shaft,
+            shaft_from,
+            ..
+        } = self.point();
+        let p = &dynamics.params;
+        let mut dx = [0.0; NX];
+        let xi_dot = p.r_L * loads.omega_L - p.r_M * shaft.omega;
+        (dx[0], dx[1]) = (xi_dot, loads.alpha_L);
+        if let ShaftFrom::States(_) = shaft_from {
+            (dx[2], dx[3]) = (shaft.omega, shaft.alpha);
+        }
+        dx[4..].copy_from_slice(&quadrature_rates(p, &loads, xi_dot, shaft.omega));
+        dx
+    }
+
+    /// The event indicators: ξ against the contact law's four edges, and in the gap ξ' (1
+    /// elsewhere). A touch that enters a band and leaves it within one of the importer's
+    /// steps changes no edge's sign at the step's ends, but has a turning point in the band:
+    /// the event there finds ξ past the edge and counts the impact.
+    fn event_indicators(&self) -> [f64; NZ] {
+        let now = self.now();
+        let (xi, p) = (now.xi, &now.dynamics.params);
+        let turning = if now.region == Region::Gap {
+            now.xi_dot
+        } else {
+            1.0
+        };
+        [xi + p.epsilon, xi, xi - p.G, xi - p.G - p.epsilon, turning]
+    }
+
+    fn nominals(&self) -> [f64; NX] {
+        nominals(self.now().dynamics.params.G)
+    }
+}
+
+impl Simulation {
     /// The right-hand side's operating point at the current time and states, with the
     /// formula of the region ξ is in.
     pub(super) fn point(&self) -> Point<'_> {
@@ -129,53 +177,11 @@ impl Simulation {
         }
     }
 
-    /// dx/dt at the current time and states, with the formula of the region ξ is in: the
-    /// contact force is continuous with a continuous slope across the edges (docs/MODEL.md §2),
-    /// so the importer's solver sees a smooth enough right-hand side wherever its trial
-    /// points fall, also past an edge it has not located yet.
-    pub fn derivatives(&self) -> [f64; NX] {
-        let Point {
-            dynamics,
-            loads,
-            shaft,
-            shaft_from,
-            ..
-        } = self.point();
-        let p = &dynamics.params;
-        let mut dx = [0.0; NX];
-        let xi_dot = p.r_L * loads.omega_L - p.r_M * shaft.omega;
-        (dx[0], dx[1]) = (xi_dot, loads.alpha_L);
-        if let ShaftFrom::States(_) = shaft_from {
-            (dx[2], dx[3]) = (shaft.omega, shaft.alpha);
-        }
-        dx[4..].copy_from_slice(&quadrature_rates(p, &loads, xi_dot, shaft.omega));
-        dx
-    }
-
     /// ∂ẋ/∂(x, u) and the outputs' partials at the current time and states
     /// (fmi2GetDirectionalDerivative; see [`Jacobian`]).
     pub fn jacobian(&self) -> Jacobian {
         let now = self.now();
         Jacobian::new(&self.point(), now.window.slopes(self.t, &now.quadratures))
-    }
-
-    /// The event indicators: ξ against the contact law's four edges, and in the gap ξ' (1
-    /// elsewhere). A touch that enters a band and leaves it within one of the importer's
-    /// steps changes no edge's sign at the step's ends, but has a turning point in the band:
-    /// the event there finds ξ past the edge and counts the impact.
-    pub fn event_indicators(&self) -> [f64; NZ] {
-        let now = self.now();
-        let (xi, p) = (now.xi, &now.dynamics.params);
-        let turning = if now.region == Region::Gap {
-            now.xi_dot
-        } else {
-            1.0
-        };
-        [xi + p.epsilon, xi, xi - p.G, xi - p.G - p.epsilon, turning]
-    }
-
-    pub fn nominals(&self) -> [f64; NX] {
-        nominals(self.now().dynamics.params.G)
     }
 
     /// The importer's time. In the inputs mode the shaft's inputs hold until set again. The

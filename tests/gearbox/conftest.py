@@ -5,40 +5,12 @@ how to build it, so that a missing build cannot pass silently."""
 
 import pytest
 
-from support.gearbox import GEARBOX_FMU_PATH, gearbox_run
+from support.fmu import session_fixtures
+from support.gearbox import BUILD_GEARBOX_FMU, GEARBOX_FMU_PATH, gearbox_run
 
 
-@pytest.fixture(scope="session")
-def gearbox_fmu() -> str:
-    if not GEARBOX_FMU_PATH.is_file():
-        pytest.fail(
-            f"{GEARBOX_FMU_PATH} does not exist: build it first with "
-            "`cargo build --release -p gearbox_rattle && cargo run --release -p packaging -- "
-            "--model GearboxRattle --lib target/release/libgearbox_rattle.so "
-            "--out target/fmu/GearboxRattle.fmu`, then rerun the tests",
-            pytrace=False,
-        )
-    return str(GEARBOX_FMU_PATH)
-
-
-@pytest.fixture(scope="session")
-def box_md(gearbox_fmu):
-    from fmpy import read_model_description
-
-    return read_model_description(gearbox_fmu)
-
-
-@pytest.fixture(scope="session")
-def box_unzipdir(gearbox_fmu, tmp_path_factory) -> str:
-    from fmpy import extract
-
-    return extract(gearbox_fmu, unzipdir=str(tmp_path_factory.mktemp("GearboxRattle_fmu")))
-
-
-@pytest.fixture(scope="session")
-def box_vrs(box_md) -> dict:
-    """name -> value reference."""
-    return {v.name: v.valueReference for v in box_md.modelVariables}
+gearbox_fmu, box_md, box_unzipdir, box_vrs = session_fixtures(
+    GEARBOX_FMU_PATH, BUILD_GEARBOX_FMU, ("gearbox_fmu", "box_md", "box_unzipdir", "box_vrs"))
 
 
 @pytest.fixture(scope="session")

@@ -9,38 +9,22 @@ import re
 
 import numpy as np
 import pytest
-from fmpy import extract, read_model_description, simulate_fmu
 from fmpy.fmi3 import FMU3Model, FMU3Slave
 
+from gearrattle import fmpy_run
 from gearrattle import gearbox_fmu as GF
 from support.early_return import step_to_impacts
+from support.fmu import session_fixtures
 
 GEARBOX_FMU3_PATH = GF.ROOT / "target" / "fmu" / "fmi3" / "GearboxRattle.fmu"
+BUILD_GEARBOX_FMU3 = (
+    "`make fmu` (or `cargo run --release -p packaging -- --model GearboxRattle --fmi 3 --lib "
+    "target/release/libgearbox_rattle.so`)"
+)
 
 
-@pytest.fixture(scope="module")
-def box3_path():
-    if not GEARBOX_FMU3_PATH.is_file():
-        pytest.fail(f"{GEARBOX_FMU3_PATH} does not exist: build it with `make fmu` (or `cargo run "
-                    "--release -p packaging -- --model GearboxRattle --fmi 3 --lib "
-                    "target/release/libgearbox_rattle.so`)", pytrace=False)
-    return str(GEARBOX_FMU3_PATH)
-
-
-@pytest.fixture(scope="module")
-def box3_md(box3_path):
-    # validate=True: the FMI 3.0 XML schema and FMPy's checks of the description.
-    return read_model_description(box3_path, validate=True)
-
-
-@pytest.fixture(scope="module")
-def box3_unzipdir(box3_path, tmp_path_factory):
-    return extract(box3_path, unzipdir=str(tmp_path_factory.mktemp("GearboxRattle_fmi3")))
-
-
-@pytest.fixture(scope="module")
-def vr3(box3_md):
-    return {v.name: v.valueReference for v in box3_md.modelVariables}
+box3_path, box3_md, box3_unzipdir, vr3 = session_fixtures(
+    GEARBOX_FMU3_PATH, BUILD_GEARBOX_FMU3, ("box3_path", "box3_md", "box3_unzipdir", "vr3"))
 
 
 def fmi3_name(fmi2_name: str) -> str:
@@ -50,12 +34,10 @@ def fmi3_name(fmi2_name: str) -> str:
 
 
 def simulate3(unzipdir, md, t_end, dt, fmi_type="CoSimulation", tol=None, **start):
-    """simulate_fmu on the FMI 3.0 FMU, the outputs GF.simulate records (the gears' as arrays)."""
-    res = simulate_fmu(unzipdir, model_description=md, fmi_type=fmi_type, solver="CVode",
-                       start_time=0.0, stop_time=t_end, start_values=start, step_size=dt,
-                       output_interval=dt, relative_tolerance=tol,
-                       output=list(GF.BOX_OUTPUTS) + [f"gear.{f}" for f in GF.GEAR_OUTPUTS])
-    return res if fmi_type == "CoSimulation" else GF.on_grid(res, dt)
+    """The FMI 3.0 FMU through simulate_fmu, the outputs GF.simulate records (the gears' as
+    arrays)."""
+    output = list(GF.BOX_OUTPUTS) + [f"gear.{f}" for f in GF.GEAR_OUTPUTS]
+    return fmpy_run.simulate(unzipdir, t_end, dt, output, fmi_type, tol, model_description=md, **start)
 
 
 def test_validates_with_enumerations_and_arrays(box3_path, box3_md, box_md):

@@ -9,14 +9,14 @@ import pytest
 
 from gearrattle import gearbox_masters as GM
 from gearrattle.masters import FLYWHEEL_FMU, OMEGA_IDLE
+from support.fmu import require
 
 T_END, H = 0.2, 1e-4
 
 
 @pytest.fixture(scope="module")
 def runs(gearbox_fmu):
-    if not FLYWHEEL_FMU.is_file():
-        pytest.fail(f"{FLYWHEEL_FMU} does not exist: build it with `make flywheel-fmu`, then rerun", pytrace=False)
+    require(FLYWHEEL_FMU, "`make flywheel-fmu`")
     return {m: run(T_END, H) for m, run in GM.MASTERS.items()}
 
 

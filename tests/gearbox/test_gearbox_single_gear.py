@@ -12,11 +12,10 @@ difference over 0.3 s is 1.6e-6, 2.3e-8, 1.6e-10 G, scaling with the tolerance."
 import functools
 
 import numpy as np
-import pytest
 
 from gearrattle import gearbox_fmu as GF
 from gearrattle import gearbox_reference as R
-from support.fmu import FMU_PATH as GEAR_FMU
+from support.fmu import BUILD_FMU, FMU_PATH, require
 
 T_END, DT, TOL = 0.3, 1e-4, 1e-12
 # GearRattle's parameters under gear 1's names in the gearbox (rho = 1, T_oil = 40 °C: C as given).
@@ -40,14 +39,13 @@ def _signal(names, m):
 def test_one_gear_on_recorded_input_side_matches_gear_rattle(gearbox_fmu):
     from fmpy import simulate_fmu
 
-    if not GEAR_FMU.is_file():
-        pytest.fail(f"{GEAR_FMU} does not exist: build it with `make fmu`, then rerun", pytrace=False)
+    gear_fmu = require(FMU_PATH, BUILD_FMU)
     m = _motion()
     p = R.params("B1")
     g1 = {k: p[f"gear[1].{k}"] for k in SHARED}
     box = GF.simulate(gearbox_fmu, T_END, DT, tol=TOL, inputs=_signal(("theta_I", "omega_I", "alpha_I"), m),
                       n_gears=1, excitation=2, **{f"gear[1].{k}": v for k, v in g1.items()})
-    pair = simulate_fmu(str(GEAR_FMU), start_time=0.0, stop_time=T_END, step_size=DT, output_interval=DT,
+    pair = simulate_fmu(gear_fmu, start_time=0.0, stop_time=T_END, step_size=DT, output_interval=DT,
                         relative_tolerance=TOL, start_values=g1,
                         input=_signal(("theta_M", "omega_M", "alpha_M"), m),
                         output=["xi", "xi_dot", "impacts_Fplus", "impacts_Fminus"])

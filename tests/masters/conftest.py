@@ -10,14 +10,14 @@ import pytest
 
 from gearrattle import masters as MS
 from gearrattle import monolithic as M
+from support.fmu import BUILD_FMU, require
 
 
 @pytest.fixture(scope="session")
 def fmus():
     """(GearRattle.fmu, Flywheel.fmu)."""
-    for path, how in ((MS.GEAR_FMU, "make fmu"), (MS.FLYWHEEL_FMU, "make flywheel-fmu")):
-        if not path.is_file():
-            pytest.fail(f"{path} does not exist: build it with `{how}` (or `make test`), then rerun", pytrace=False)
+    require(MS.GEAR_FMU, BUILD_FMU)
+    require(MS.FLYWHEEL_FMU, "`make flywheel-fmu`")
     return MS.GEAR_FMU, MS.FLYWHEEL_FMU
 
 

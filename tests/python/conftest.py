@@ -5,39 +5,13 @@ with a message telling how to build it, so that a missing build cannot pass sile
 
 import pytest
 
+from gearrattle import fmpy_run
 from gearrattle import reference as R
-from support.fmu import FMU_PATH, OUTPUTS, main_shaft_input
+from support.fmu import BUILD_FMU, FMU_PATH, OUTPUTS, main_shaft_input, session_fixtures
 
 
-@pytest.fixture(scope="session")
-def fmu_path() -> str:
-    if not FMU_PATH.is_file():
-        pytest.fail(
-            f"{FMU_PATH} does not exist: build it first with `make fmu` "
-            "(or `cargo run --release -p packaging -- --model GearRattle`), then rerun the tests",
-            pytrace=False,
-        )
-    return str(FMU_PATH)
-
-
-@pytest.fixture(scope="session")
-def model_description(fmu_path):
-    from fmpy import read_model_description
-
-    return read_model_description(fmu_path)
-
-
-@pytest.fixture(scope="session")
-def unzipdir(fmu_path, tmp_path_factory) -> str:
-    from fmpy import extract
-
-    return extract(fmu_path, unzipdir=str(tmp_path_factory.mktemp("GearRattle_fmu")))
-
-
-@pytest.fixture(scope="session")
-def vrs(model_description) -> dict:
-    """name -> value reference."""
-    return {v.name: v.valueReference for v in model_description.modelVariables}
+fmu_path, model_description, unzipdir, vrs = session_fixtures(
+    FMU_PATH, BUILD_FMU, ("fmu_path", "model_description", "unzipdir", "vrs"))
 
 
 @pytest.fixture
@@ -75,8 +49,6 @@ def fmu_run(unzipdir, model_description):
     The communication step and the output interval are both dt; tol: the relative tolerance
     (None: the model description's default, 1e-6). overrides: other parameters (start
     values; in inputs mode omega_mean, f_exc, A_rms shape the input signal instead)."""
-    from fmpy import simulate_fmu
-
     cache = {}
 
     def run(mode: str, scene: str, t_end: float, dt: float = 1e-4, fields=("theta_M", "omega_M", "alpha_M"), tol=None, **overrides):
@@ -92,18 +64,8 @@ def fmu_run(unzipdir, model_description):
                 inp = main_shaft_input(scene, t_end, dt, fields, **shaft)
             else:
                 raise ValueError(mode)
-            cache[key] = simulate_fmu(
-                unzipdir,
-                model_description=model_description,
-                start_time=0.0,
-                stop_time=t_end,
-                start_values=start,
-                input=inp,
-                step_size=dt,
-                output_interval=dt,
-                relative_tolerance=tol,
-                output=OUTPUTS,
-            )
+            cache[key] = fmpy_run.simulate(unzipdir, t_end, dt, OUTPUTS, tol=tol, inputs=inp,
+                                              model_description=model_description, **start)
         return cache[key]
 
     return run

@@ -10,34 +10,18 @@ import zipfile
 
 import numpy as np
 import pytest
-from fmpy import extract, read_model_description, simulate_fmu
+from fmpy import read_model_description, simulate_fmu
 from fmpy.fmi1 import FMICallException
 from fmpy.fmi3 import FMU3Model, FMU3Slave
-from support.fmu import FMU3_PATH, FMU_PATH, OUTPUTS, main_shaft_input
+from support.early_return import step_to_impacts
+from support.fmu import BUILD_FMU3, FMU3_PATH, FMU_PATH, OUTPUTS, main_shaft_input, session_fixtures
 
 from gearrattle import reference as R
-from support.early_return import step_to_impacts
 
 G = 25e-6
 
 
-@pytest.fixture(scope="module")
-def fmu3_path():
-    if not FMU3_PATH.is_file():
-        pytest.fail(f"{FMU3_PATH} does not exist: build it with `make fmu` (or `cargo run --release "
-                    "-p packaging -- --model GearRattle --fmi 3`)", pytrace=False)
-    return str(FMU3_PATH)
-
-
-@pytest.fixture(scope="module")
-def md3(fmu3_path):
-    # validate=True: the FMI 3.0 XML schema and FMPy's checks of the description.
-    return read_model_description(fmu3_path, validate=True)
-
-
-@pytest.fixture(scope="module")
-def unzipdir3(fmu3_path, tmp_path_factory):
-    return extract(fmu3_path, unzipdir=str(tmp_path_factory.mktemp("GearRattle_fmi3")))
+fmu3_path, md3, unzipdir3 = session_fixtures(FMU3_PATH, BUILD_FMU3, ("fmu3_path", "md3", "unzipdir3"))
 
 
 def vr_of(md, name):

@@ -3,15 +3,13 @@ Dask cluster on localhost, started once for the session."""
 
 import pytest
 
-from support.fmu import FMU_PATH
+from support.fmu import BUILD_FMU, FMU_PATH, require
 from support.study import LocalhostCluster
 
 
 @pytest.fixture(scope="session")
 def fmu():
-    if not FMU_PATH.is_file():
-        pytest.fail(f"{FMU_PATH} is missing: build it with `make fmu`")
-    return str(FMU_PATH)
+    return require(FMU_PATH, BUILD_FMU)
 
 
 @pytest.fixture(scope="session")
@@ -23,8 +21,6 @@ def cluster(tmp_path_factory):
 
 @pytest.fixture(scope="session")
 def gearbox_fmu():
-    from support.gearbox import GEARBOX_FMU_PATH
+    from support.gearbox import BUILD_GEARBOX_FMU, GEARBOX_FMU_PATH
 
-    if not GEARBOX_FMU_PATH.is_file():
-        pytest.fail(f"{GEARBOX_FMU_PATH} is missing: build it as tests/gearbox/conftest.py says")
-    return str(GEARBOX_FMU_PATH)
+    return require(GEARBOX_FMU_PATH, BUILD_GEARBOX_FMU)

@@ -10,9 +10,14 @@ import numpy as np
 
 from gearrattle import gearbox_fmu as GF
 from gearrattle import gearbox_reference as R
+from gearrattle import piecewise
 from gearrattle import reference as gear_reference
 
 GEARBOX_FMU_PATH = GF.GEARBOX_FMU
+BUILD_GEARBOX_FMU = (
+    "`make fmu` (or `cargo rustc --release -p gearbox_rattle --lib --crate-type cdylib && cargo run --release "
+    "-p packaging -- --model GearboxRattle --lib target/release/libgearbox_rattle.so --out target/fmu/GearboxRattle.fmu`)"
+)
 # Each scene's pointwise-predictable window [s] (the reference's own perturbed runs: a 1e-10 G
 # difference grows to 1e-4 G past it) and the rate spread of its perturbed runs beyond.
 WINDOW = {"B1": 0.35, "R1": 0.40, "B2": 2.0}
@@ -24,9 +29,9 @@ CACHE = GF.ROOT / "target" / "test-cache" / "gearbox_reference"
 
 def reference_scene(scene: str, t_end: float, dt: float) -> R.Result:
     """R.scene(scene, t_end, dt), kept on disk under target/test-cache between sessions (its
-    2 s scenes cost some 80 s): the key holds both reference modules' source, so that an edit
-    of the reference recomputes it."""
-    source = "".join(inspect.getsource(m) for m in (R, gear_reference))
+    2 s scenes cost some 80 s): the key holds the source of both reference modules and of
+    their piecewise integration, so that an edit of the reference recomputes it."""
+    source = "".join(inspect.getsource(m) for m in (R, gear_reference, piecewise))
     key = hashlib.sha256(f"{source}|{scene}|{t_end!r}|{dt!r}".encode()).hexdigest()[:20]
     path = CACHE / f"{scene}-{key}.pickle"
     if path.is_file():

@@ -219,6 +219,7 @@ mod tests {
     use crate::instance::simulation::{EXCITATION_INPUTS, EXCITATION_SINE, EXCITATION_TORQUE};
     use crate::instance::{Carry, Simulation};
     use crate::physics::{GearParams, Shaft};
+    use fmi2_shell::Continuous;
     use fmi2_shell::values::Values;
 
     const T: f64 = 0.0123;
