@@ -11,6 +11,7 @@ FMU := target/fmu/GearRattle.fmu
 GEARBOX_FMU := target/fmu/GearboxRattle.fmu
 # The models whose FMU comes in FMI 3.0 too, in target/fmu/fmi3/ (the same binaries, fmi3-shell's exports).
 FMU3_MODELS := GearRattle GearboxRattle
+# The host build of GearRattle's library (the benchmarks step it from C).
 LIB := target/release/libgear_rattle.so
 # The FMUs `make fmu` builds, by model identifier, and the crate of each one's binary.
 MODELS := GearRattle GearboxRattle
@@ -57,12 +58,12 @@ endef
 $(foreach m,$(MODELS),$(eval $(call fmu_rule,$(m),2,target/fmu)))
 $(foreach m,$(FMU3_MODELS),$(eval $(call fmu_rule,$(m),3,target/fmu/fmi3)))
 
-# The native library, loaded by the C-API tests (the FMU's linux64 binary is built by
-# mk/portable.mk), built as a cdylib alone like the packaged ones: the crate's own crate type is
-# rlib, so that the gearbox, which links it, does not build a second cdylib of it. cargo decides
+# The host's cdylib of a crate (target/release/lib<crate>.so), for the demo's FMUs and the
+# benchmarks, built alone like the packaged ones: the crates' own crate type is rlib, so that
+# the gearbox, which links gear_rattle, does not build a second cdylib of it. cargo decides
 # what to rebuild; this rule always asks it.
-$(LIB): FORCE | libclang
-	cargo rustc --release -p gear_rattle --lib --crate-type cdylib
+target/release/lib%.so: FORCE | libclang
+	cargo rustc --release -p $* --lib --crate-type cdylib
 
 FORCE:
 
@@ -70,9 +71,11 @@ FORCE:
 # packages the shipped ones, so that the first result waits for no cross build
 # (docs/DEVELOPING.md).
 HOST_FMU := target/fmu/host
-$(HOST_FMU)/%.fmu: FORCE | libclang
-	cargo rustc --release -p $(crate_$*) --lib --crate-type cdylib
-	$(PACKAGE) --model $* --lib target/release/lib$(crate_$*).so --out $@
+define host_fmu_rule
+$(HOST_FMU)/$(1).fmu: target/release/lib$(crate_$(1)).so
+	$$(PACKAGE) --model $(1) --lib $$< --out $$@
+endef
+$(foreach m,$(MODELS),$(eval $(call host_fmu_rule,$(m))))
 
 ## demo: the bench scenes, then the gearbox, through fmpy (summaries, plots, sounds in target/demo), then `make fmu`
 demo: $(VENV)/.demo-installed $(HOST_FMU)/GearRattle.fmu
@@ -85,12 +88,14 @@ demo: $(VENV)/.demo-installed $(HOST_FMU)/GearRattle.fmu
 ## test: every test: Rust (cargo test) and the FMU as a user runs it (pytest + fmpy)
 test: $(TEST_TARGETS)
 
-# The C-API tests load the cdylib, which `cargo test` alone does not produce. fmi2-shell's
+# The C-API tests load the FMU's linux64 binary as cargo-zigbuild builds it (mk/portable.mk):
+# the library shipped, and no second release build of it. fmi2-shell's
 # own tests check FMI's rules on a model of their own, fmi3-shell's its state table. The
 # gearbox's crate is tested on its own: built with gear_rattle in one cargo call, gear_rattle's
 # `fmu` feature (its exports) would be on for the gearbox too, whose own would clash with them.
-test-rust: $(LIB) | libclang
-	$(CARGO_TEST) -p gear_rattle -p fmi2-shell -p fmi3-shell
+CAPI_LIB = $(call linux_so,gear_rattle)
+test-rust: $(CAPI_LIB) | libclang
+	GEAR_RATTLE_CDYLIB=$(abspath $(CAPI_LIB)) $(CARGO_TEST) -p gear_rattle -p fmi2-shell -p fmi3-shell
 	$(CARGO_TEST) -p gearbox_rattle
 
 test-python: fmu $(VENV)/.installed

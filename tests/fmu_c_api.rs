@@ -9,16 +9,20 @@ use packaging::{Binary, models, write_fmu};
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
-/// The shipped cdylib, target/release/libgear_rattle.so, found from this test executable's
-/// path (target/<profile>/deps/…): the tests build in the `quick` profile, the FMU's binary in
-/// `release`.
+/// The cdylib under test: GEAR_RATTLE_CDYLIB (`make test` names the FMU's linux64 binary),
+/// else target/release/libgear_rattle.so, found from this test executable's path
+/// (target/<profile>/deps/…).
 fn cdylib() -> PathBuf {
-    let exe = std::env::current_exe().unwrap();
-    let target = exe.ancestors().nth(3).unwrap();
-    let lib = target.join("release/libgear_rattle.so");
+    let lib = std::env::var_os("GEAR_RATTLE_CDYLIB").map_or_else(
+        || {
+            let exe = std::env::current_exe().unwrap();
+            exe.ancestors().nth(3).unwrap().join("release/libgear_rattle.so")
+        },
+        PathBuf::from,
+    );
     assert!(
         lib.exists(),
-        "{} is missing: build it first with `cargo rustc --release -p gear_rattle --lib --crate-type cdylib` (make test does)",
+        "{} is missing: build it first with `cargo rustc --release -p gear_rattle --lib --crate-type cdylib` (make test builds the FMU's linux64 binary)",
         lib.display()
     );
     lib
