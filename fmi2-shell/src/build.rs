@@ -18,6 +18,8 @@
 //! array's variable named bare means the same element's, and `NAME[*].VAR` every element's.
 //! Consecutive declarations of one array expand element by element. The Rust constants give
 //! each array a module, `vr::NAME`, with the value references as arrays (`vr::gear::I_L[i - 1]`).
+//! FMI 3.0 declares each array variable once, sized by the Integer parameter `n_NAMEs`
+//! (`n_gears`, a structural parameter there; [`fmi3`]), and `FMI3_ARRAYS` tells fmi3-shell.
 
 mod fmi3;
 
@@ -51,6 +53,12 @@ struct Array {
 }
 
 impl Array {
+    /// The Integer parameter that gives the array's length in FMI 3.0 (its structural
+    /// parameter): `n_gears` for `gear`.
+    fn size_parameter(&self) -> String {
+        format!("n_{}s", self.name)
+    }
+
     /// Element i's variable: `gear[i].xi`, and `der(gear[i].xi)` for `der(xi)`.
     fn element_name(&self, i: usize, name: &str) -> String {
         match name.strip_prefix("der(").and_then(|n| n.strip_suffix(')')) {
@@ -178,7 +186,7 @@ impl Variable {
 
     fn variability(&self) -> &'static str {
         match (self.causality.as_str(), self.ty.as_str()) {
-            ("parameter", _) => "fixed",
+            ("parameter" | "structuralParameter", _) => "fixed",
             (_, "Integer") => "discrete",
             _ => "continuous",
         }
@@ -317,6 +325,18 @@ fn resolve(arrays: &[Array], names: &[String]) -> Vec<String> {
 
 /// Refuses a contract that would give an invalid or ambiguous FMU.
 fn check(c: &Contract) {
+    for a in &c.array {
+        let n = a.size_parameter();
+        assert!(
+            c.variable.iter().any(|v| v.name == n
+                && v.ty == "Integer"
+                && v.causality == "parameter"
+                && v.max.as_ref().and_then(toml::Value::as_integer) == Some(a.size as i64)),
+            "array {}: FMI 3.0 sizes it by the Integer parameter {n} with max = {}",
+            a.name,
+            a.size
+        );
+    }
     let mut seen = BTreeMap::new();
     for v in &c.variable {
         assert!(
@@ -813,6 +833,19 @@ fn rust(c: &Contract, guid: &str) -> String {
         c.model.event_indicators
     )
     .unwrap();
+    r += "/// FMI 3.0: the arrays, each sized by its structural parameter.\npub const FMI3_ARRAYS: &[fmi2_shell::contract::fmi3::Array] = &[\n";
+    for a in &c.array {
+        writeln!(
+            r,
+            "    fmi2_shell::contract::fmi3::Array {{ size_vr: {}, size: {}, vr_base: {}, vr_stride: {} }},",
+            vr_of(&a.size_parameter()),
+            a.size,
+            a.vr_base,
+            a.vr_stride
+        )
+        .unwrap();
+    }
+    r += "];\n\n";
     r += "/// Index in VARIABLES of the variable of a kind and value reference (a jump table, not\n/// a search: fmi2GetReal looks every reference up).\npub fn index(kind: Kind, vr: u32) -> Option<usize> {\n    match (kind, vr) {\n";
     for (i, v) in c.variable.iter().enumerate() {
         writeln!(r, "        (Kind::{}, {}) => Some({i}),", v.ty, v.vr).unwrap();

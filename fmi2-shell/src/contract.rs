@@ -215,4 +215,36 @@ pub mod fmi3 {
     pub const TIME_VR: u32 = 2_000_000;
     /// The first event indicator's; the k-th (from 0) is this + k.
     pub const EVENT_INDICATOR_VR: u32 = TIME_VR + 1;
+
+    /// A contract's array (`gear`) as FMI 3.0 declares it: each of its variables one array
+    /// of length `n`, the value of the structural parameter `size_vr` (an Integer of the
+    /// contract, 1..=`size`). The array variable of offset k has the reference
+    /// `vr_base + k` (below element 1's block), its element i (1-based) the contract's
+    /// `vr_base + vr_stride i + k`, Real and Integer alike.
+    #[derive(Clone, Copy, Debug)]
+    pub struct Array {
+        pub size_vr: u32,
+        pub size: usize,
+        pub vr_base: u32,
+        pub vr_stride: u32,
+    }
+
+    impl Array {
+        /// The offset of the array variable with the contract reference `vr`, if it is one.
+        pub fn offset(&self, vr: u32) -> Option<u32> {
+            vr.checked_sub(self.vr_base).filter(|k| *k < self.vr_stride)
+        }
+
+        /// The offset of the element variable `vr` (any element), if it is one.
+        pub fn element_offset(&self, vr: u32) -> Option<u32> {
+            let k = vr.checked_sub(self.vr_base + self.vr_stride)?;
+            (k < self.vr_stride * self.size as u32).then_some(k % self.vr_stride)
+        }
+
+        /// The contract references of the first `n` elements of the array variable of
+        /// offset `k`.
+        pub fn elements(&self, k: u32, n: usize) -> impl Iterator<Item = u32> + '_ {
+            (1..=n as u32).map(move |i| self.vr_base + self.vr_stride * i + k)
+        }
+    }
 }

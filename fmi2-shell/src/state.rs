@@ -18,10 +18,13 @@ pub enum FmiState {
     Terminated,
     /// A step failed (or a panic was caught): only inspection, reset and free remain.
     Error,
+    /// FMI 3.0's configuration mode: the structural parameters may be set (never entered by
+    /// FMI 2.0's functions).
+    ConfigurationMode,
 }
 
 impl FmiState {
-    pub const ALL: [FmiState; 7] = [
+    pub const ALL: [FmiState; 8] = [
         FmiState::Instantiated,
         FmiState::InitializationMode,
         FmiState::StepComplete,
@@ -29,6 +32,7 @@ impl FmiState {
         FmiState::ContinuousTimeMode,
         FmiState::Terminated,
         FmiState::Error,
+        FmiState::ConfigurationMode,
     ];
 
     fn bit(self) -> u8 {
@@ -40,6 +44,7 @@ impl FmiState {
             FmiState::ContinuousTimeMode => CONTINUOUS,
             FmiState::Terminated => TERMINATED,
             FmiState::Error => ERROR,
+            FmiState::ConfigurationMode => CONFIGURATION,
         }
     }
 
@@ -50,7 +55,10 @@ impl FmiState {
 
     /// Whether fmi2ExitInitializationMode has passed (the parameters are fixed).
     pub fn is_initialised(self) -> bool {
-        !matches!(self, FmiState::Instantiated | FmiState::InitializationMode)
+        !matches!(
+            self,
+            FmiState::Instantiated | FmiState::InitializationMode | FmiState::ConfigurationMode
+        )
     }
 }
 
@@ -62,8 +70,9 @@ pub const EVENT: u8 = 8;
 pub const CONTINUOUS: u8 = 16;
 pub const TERMINATED: u8 = 32;
 pub const ERROR: u8 = 64;
+pub const CONFIGURATION: u8 = 128;
 pub const RUNNING: u8 = STEP_COMPLETE | EVENT | CONTINUOUS;
-pub const ANY: u8 = INSTANTIATED | INITIALIZATION | RUNNING | TERMINATED | ERROR;
+pub const ANY: u8 = INSTANTIATED | INITIALIZATION | RUNNING | TERMINATED | ERROR | CONFIGURATION;
 
 /// States in which each FMI function may be called.
 pub mod allowed {

@@ -1,12 +1,13 @@
 //! What the `fmi3*` exports ([`export_fmi3!`](crate::export_fmi3)) do beyond calling the
 //! instance: instantiation of each interface, FMI 3.0's value references on the slave's
-//! (Real ones as they are, Integer ones moved, the time and the event indicators as
-//! variables), the answers FMI 3.0 asks through pointers, and the adjoint derivatives.
+//! (Real ones as they are, Integer ones moved, arrays as their elements, the time and the
+//! event indicators as variables), the answers FMI 3.0 asks through pointers, and the adjoint derivatives.
 #![allow(clippy::missing_safety_doc)]
 
+use crate::arrays;
 use fmi_sys::fmi3::*;
 use fmi2_shell::component::{Component, slice_mut};
-use fmi2_shell::contract::fmi3::{EVENT_INDICATOR_VR, INTEGER_VR_OFFSET, TIME_VR};
+use fmi2_shell::contract::fmi3::{Array, EVENT_INDICATOR_VR, INTEGER_VR_OFFSET, TIME_VR};
 use fmi2_shell::contract::{Kind, unknown};
 use fmi2_shell::export::{check_token, create};
 use fmi2_shell::logger::Logger;
@@ -139,7 +140,7 @@ pub fn scalars(n_vr: usize, n_values: usize) -> FmiResult {
 }
 
 /// The contract's Integer references of FMI 3.0's ones (Int32 and Enumeration variables).
-fn integer_vrs(vrs: &[u32]) -> FmiResult<Vec<u32>> {
+fn contract_integers(vrs: &[u32]) -> FmiResult<Vec<u32>> {
     vrs.iter()
         .map(|&vr| {
             vr.checked_sub(INTEGER_VR_OFFSET)
@@ -149,14 +150,41 @@ fn integer_vrs(vrs: &[u32]) -> FmiResult<Vec<u32>> {
         .collect()
 }
 
-/// fmi3GetFloat64: the slave's Real variables, the time and the event indicators (the
-/// slave's whole vector of `indicators` computed once if any is asked).
+/// The slave's Integer references of FMI 3.0's Int32 and Enumeration ones, `n_values` in all
+/// ([`arrays::expand`]); a structural parameter is none of them.
+fn integer_vrs<S: Slave>(
+    fmu: &mut Fmu<S>,
+    arrays: &[Array],
+    vrs: &[u32],
+    n_values: usize,
+) -> FmiResult<Vec<u32>> {
+    let vrs = contract_integers(vrs)?;
+    arrays::no_structural_parameter(arrays, &vrs)?;
+    arrays::expand(fmu, arrays, &vrs, n_values)
+}
+
+/// fmi3SetFloat64: the slave's Reals (an array's as its elements).
+pub fn set_float64<S: Slave>(
+    fmu: &mut Fmu<S>,
+    arrays: &[Array],
+    vrs: &[u32],
+    values: &[f64],
+) -> FmiResult {
+    let vrs = arrays::expand(fmu, arrays, vrs, values.len())?;
+    fmu.set_real(&vrs, values)
+}
+
+/// fmi3GetFloat64: the slave's Real variables (an array's as its elements,
+/// [`arrays::expand`]), the time and the event indicators (the slave's whole vector of
+/// `indicators` computed once if any is asked).
 pub fn get_float64<S: Slave>(
     fmu: &mut Fmu<S>,
+    arrays: &[Array],
     vrs: &[u32],
     out: &mut [f64],
     indicators: usize,
 ) -> FmiResult {
+    let vrs = &arrays::expand(fmu, arrays, vrs, out.len())?;
     if vrs.iter().all(|&vr| vr < TIME_VR) {
         return fmu.slave.get_real(vrs, out);
     }
@@ -183,13 +211,15 @@ pub fn get_float64<S: Slave>(
     Ok(())
 }
 
-/// fmi3GetInt32 (Int32 variables) and fmi3GetInt64 (Enumerations): the slave's Integers.
+/// fmi3GetInt32 (Int32 variables) and fmi3GetInt64 (Enumerations): the slave's Integers
+/// (an array's as its elements).
 pub fn get_integer<S: Slave, T: From<i32>>(
     fmu: &mut Fmu<S>,
+    arrays: &[Array],
     vrs: &[u32],
     out: &mut [T],
 ) -> FmiResult {
-    let vrs = integer_vrs(vrs)?;
+    let vrs = integer_vrs(fmu, arrays, vrs, out.len())?;
     let mut values = vec![0; vrs.len()];
     fmu.slave.get_integer(&vrs, &mut values)?;
     for (out, v) in out.iter_mut().zip(values) {
@@ -198,16 +228,18 @@ pub fn get_integer<S: Slave, T: From<i32>>(
     Ok(())
 }
 
-/// fmi3SetInt32 and fmi3SetInt64: the slave's Integers, a value beyond Int32 refused.
+/// fmi3SetInt32 and fmi3SetInt64: the slave's Integers (an array's as its elements), a
+/// value beyond Int32 refused.
 pub fn set_integer<S: Slave, T: Copy + std::fmt::Display>(
     fmu: &mut Fmu<S>,
+    arrays: &[Array],
     vrs: &[u32],
     values: &[T],
 ) -> FmiResult
 where
     i32: TryFrom<T>,
 {
-    let vrs = integer_vrs(vrs)?;
+    let vrs = integer_vrs(fmu, arrays, vrs, values.len())?;
     let values = values
         .iter()
         .map(|&v| {
@@ -312,11 +344,11 @@ mod tests {
     #[test]
     fn integer_references_are_moved_by_the_offset() {
         assert_eq!(
-            integer_vrs(&[INTEGER_VR_OFFSET + 102, INTEGER_VR_OFFSET]).unwrap(),
+            contract_integers(&[INTEGER_VR_OFFSET + 102, INTEGER_VR_OFFSET]).unwrap(),
             [102, 0]
         );
         for vr in [102, TIME_VR, EVENT_INDICATOR_VR + 1] {
-            assert!(integer_vrs(&[vr]).is_err(), "{vr}");
+            assert!(contract_integers(&[vr]).is_err(), "{vr}");
         }
         assert!(scalars(3, 3).is_ok() && scalars(3, 4).is_err());
     }

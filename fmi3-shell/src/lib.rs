@@ -12,16 +12,19 @@
 //!   Enumerations as Int64, the adjoint derivatives from the directional ones, the
 //!   instantiation of each interface, Co-Simulation's early return at the model's events
 //!   ([`Slave::step_to_event`]) and its event mode, as the importer allows them;
+//! - a contract's arrays as FMI 3.0's array variables sized by structural parameters, set in
+//!   configuration mode ([`arrays`]);
 //! - the exports themselves ([`export_fmi3!`]).
 //!
-//! Not offered: intermediate updates, clocks, scheduled execution, configuration mode (the
-//! model has no structural parameter); their functions refuse with a log line.
+//! Not offered: intermediate updates, clocks, scheduled execution, and configuration mode for
+//! a model without structural parameters; their functions refuse with a log line.
 //!
 //! [`Slave::step_to_event`]: fmi2_shell::Slave::step_to_event
 //!
 //! [`Slave`]: fmi2_shell::Slave
 //! [`Fmu`]: fmi2_shell::Fmu
 
+pub mod arrays;
 pub mod export;
 mod macros;
 pub mod state;

@@ -23,6 +23,7 @@ macro_rules! __fmi3_exports {
             use ::fmi2_shell::fmu_state;
             use ::fmi2_shell::Interface;
             use $crate::export as e3;
+            use $crate::arrays as ar;
             use $contract as contract;
 
             #[unsafe(no_mangle)]
@@ -105,35 +106,30 @@ macro_rules! __fmi3_exports {
             fn fmi3Terminate() TERMINATE |s| s.terminate();
             fn fmi3Reset() RESET |s| s.reset();
 
+            // nValues values for the nvr references: an array's as many as its length.
             fn fmi3GetFloat64(vr: *const fmi3ValueReference, nvr: usize, value: *mut fmi3Float64, nValues: usize)
-                GET |s| {
-                    e3::scalars(nvr, nValues)?;
-                    e3::get_float64(s, array!(vr, nvr), array!(mut value, nvr), contract::EVENT_INDICATORS)
-                };
+                GET |s| e3::get_float64(s, contract::FMI3_ARRAYS, array!(vr, nvr), array!(mut value, nValues),
+                    contract::EVENT_INDICATORS);
             fn fmi3GetInt32(vr: *const fmi3ValueReference, nvr: usize, value: *mut fmi3Int32, nValues: usize)
-                GET |s| {
-                    e3::scalars(nvr, nValues)?;
-                    e3::get_integer(s, array!(vr, nvr), array!(mut value, nvr))
-                };
+                GET |s| e3::get_integer(s, contract::FMI3_ARRAYS, array!(vr, nvr), array!(mut value, nValues));
             fn fmi3GetInt64(vr: *const fmi3ValueReference, nvr: usize, value: *mut fmi3Int64, nValues: usize)
-                GET |s| {
-                    e3::scalars(nvr, nValues)?;
-                    e3::get_integer(s, array!(vr, nvr), array!(mut value, nvr))
-                };
+                GET |s| e3::get_integer(s, contract::FMI3_ARRAYS, array!(vr, nvr), array!(mut value, nValues));
             fn fmi3SetFloat64(vr: *const fmi3ValueReference, nvr: usize, value: *const fmi3Float64, nValues: usize)
-                SET |s| {
-                    e3::scalars(nvr, nValues)?;
-                    s.set_real(array!(vr, nvr), array!(value, nvr))
-                };
+                SET |s| e3::set_float64(s, contract::FMI3_ARRAYS, array!(vr, nvr), array!(value, nValues));
             fn fmi3SetInt32(vr: *const fmi3ValueReference, nvr: usize, value: *const fmi3Int32, nValues: usize)
-                SET |s| {
-                    e3::scalars(nvr, nValues)?;
-                    e3::set_integer(s, array!(vr, nvr), array!(value, nvr))
-                };
+                SET |s| e3::set_integer(s, contract::FMI3_ARRAYS, array!(vr, nvr), array!(value, nValues));
             fn fmi3SetInt64(vr: *const fmi3ValueReference, nvr: usize, value: *const fmi3Int64, nValues: usize)
-                SET |s| {
+                SET |s| e3::set_integer(s, contract::FMI3_ARRAYS, array!(vr, nvr), array!(value, nValues));
+            // The structural parameters (set in configuration mode).
+            fn fmi3GetUInt64(vr: *const fmi3ValueReference, nvr: usize, value: *mut fmi3UInt64, nValues: usize)
+                GET_STRUCTURAL |s| {
                     e3::scalars(nvr, nValues)?;
-                    e3::set_integer(s, array!(vr, nvr), array!(value, nvr))
+                    ar::get_uint64(s, contract::FMI3_ARRAYS, array!(vr, nvr), array!(mut value, nvr))
+                };
+            fn fmi3SetUInt64(vr: *const fmi3ValueReference, nvr: usize, value: *const fmi3UInt64, nValues: usize)
+                SET_STRUCTURAL |s| {
+                    e3::scalars(nvr, nValues)?;
+                    ar::set_uint64(s, contract::FMI3_ARRAYS, array!(vr, nvr), array!(value, nvr))
                 };
             // Types the model has no variables of.
             fn fmi3GetFloat32(vr: *const fmi3ValueReference, nvr: usize, _v: *mut fmi3Float32, _n: usize)
@@ -148,8 +144,6 @@ macro_rules! __fmi3_exports {
                 GET |_| no_variables("UInt16", array!(vr, nvr));
             fn fmi3GetUInt32(vr: *const fmi3ValueReference, nvr: usize, _v: *mut fmi3UInt32, _n: usize)
                 GET |_| no_variables("UInt32", array!(vr, nvr));
-            fn fmi3GetUInt64(vr: *const fmi3ValueReference, nvr: usize, _v: *mut fmi3UInt64, _n: usize)
-                GET |_| no_variables("UInt64", array!(vr, nvr));
             fn fmi3GetBoolean(vr: *const fmi3ValueReference, nvr: usize, _v: *mut fmi3Boolean, _n: usize)
                 GET |_| no_variables("Boolean", array!(vr, nvr));
             fn fmi3GetString(vr: *const fmi3ValueReference, nvr: usize, _v: *mut fmi3String, _n: usize)
@@ -169,8 +163,6 @@ macro_rules! __fmi3_exports {
                 SET |_| no_variables("UInt16", array!(vr, nvr));
             fn fmi3SetUInt32(vr: *const fmi3ValueReference, nvr: usize, _v: *const fmi3UInt32, _n: usize)
                 SET |_| no_variables("UInt32", array!(vr, nvr));
-            fn fmi3SetUInt64(vr: *const fmi3ValueReference, nvr: usize, _v: *const fmi3UInt64, _n: usize)
-                SET |_| no_variables("UInt64", array!(vr, nvr));
             fn fmi3SetBoolean(vr: *const fmi3ValueReference, nvr: usize, _v: *const fmi3Boolean, _n: usize)
                 SET |_| no_variables("Boolean", array!(vr, nvr));
             fn fmi3SetString(vr: *const fmi3ValueReference, nvr: usize, _v: *const fmi3String, _n: usize)
@@ -219,11 +211,11 @@ macro_rules! __fmi3_exports {
                         array!(seed, nUnknowns), array!(mut sensitivity, nKnowns))
                 };
 
-            // Configuration mode (structural parameters), clocks: not offered.
+            // Configuration mode, where the model has structural parameters; clocks: not offered.
             fn fmi3EnterConfigurationMode() EXPLAINED_REFUSAL
-                |_| e3::not_offered("fmi3EnterConfigurationMode: structural parameters are");
+                |s| ar::configuration_mode(s, contract::FMI3_ARRAYS, true);
             fn fmi3ExitConfigurationMode() EXPLAINED_REFUSAL
-                |_| e3::not_offered("fmi3ExitConfigurationMode: structural parameters are");
+                |s| ar::configuration_mode(s, contract::FMI3_ARRAYS, false);
             fn fmi3GetClock(_vr: *const fmi3ValueReference, _nvr: usize, _v: *mut fmi3Clock)
                 EXPLAINED_REFUSAL |_| e3::not_offered("fmi3GetClock: clocks are");
             fn fmi3SetClock(_vr: *const fmi3ValueReference, _nvr: usize, _v: *const fmi3Clock)
@@ -280,20 +272,27 @@ macro_rules! __fmi3_exports {
                     Ok(())
                 };
             fn fmi3SetTime(time: fmi3Float64) SET_TIME |s| s.set_time(time);
-            fn fmi3SetContinuousStates(x: *const fmi3Float64, nx: usize)
-                SET_CONTINUOUS_STATES |s| s.set_continuous_states(array!(x, nx));
+            // The continuous states in FMI 3.0's order (an array's elements together).
+            fn fmi3SetContinuousStates(x: *const fmi3Float64, nx: usize) SET_CONTINUOUS_STATES
+                |s| ar::set_continuous_states(s, contract::FMI3_ARRAYS, contract::STATES, array!(x, nx));
             fn fmi3GetContinuousStateDerivatives(derivatives: *mut fmi3Float64, nx: usize) GET_CONTINUOUS
-                |s| s.get_derivatives(array!(mut derivatives, nx));
+                |s| ar::gather(s, contract::FMI3_ARRAYS, contract::STATES, array!(mut derivatives, nx),
+                    |fmu, v| fmu.get_derivatives(v));
             fn fmi3GetEventIndicators(eventIndicators: *mut fmi3Float64, ni: usize) GET_CONTINUOUS
                 |s| s.get_event_indicators(array!(mut eventIndicators, ni));
             fn fmi3GetContinuousStates(x: *mut fmi3Float64, nx: usize) GET_CONTINUOUS
-                |s| s.get_continuous_states(array!(mut x, nx));
+                |s| ar::gather(s, contract::FMI3_ARRAYS, contract::STATES, array!(mut x, nx),
+                    |fmu, v| fmu.get_continuous_states(v));
             fn fmi3GetNominalsOfContinuousStates(nominals: *mut fmi3Float64, nx: usize) GET_CONTINUOUS
-                |s| s.get_nominals_of_continuous_states(array!(mut nominals, nx));
+                |s| ar::gather(s, contract::FMI3_ARRAYS, contract::STATES, array!(mut nominals, nx),
+                    |fmu, v| fmu.get_nominals_of_continuous_states(v));
             fn fmi3GetNumberOfEventIndicators(n: *mut usize) GET_NUMBER_OF
                 |_| unsafe { e3::number(n, contract::EVENT_INDICATORS) };
             fn fmi3GetNumberOfContinuousStates(n: *mut usize) GET_NUMBER_OF
-                |_| unsafe { e3::number(n, contract::STATES.len()) };
+                |s| {
+                    let states = ar::state_order(s, contract::FMI3_ARRAYS, contract::STATES)?.len();
+                    unsafe { e3::number(n, states) }
+                };
 
             // Co-Simulation.
             fn fmi3EnterStepMode() ENTER_STEP_MODE |s| e3::enter_step_mode(s);

@@ -2,9 +2,11 @@
 //! states in which it may be called (as the Reference-FMUs' masks). FMI 3.0's Step Mode is
 //! [`FmiState::StepComplete`](fmi2_shell::FmiState::StepComplete); Event Mode is both
 //! interfaces' (Co-Simulation's where the importer set eventModeUsed, which the functions
-//! check), Continuous-Time Mode Model Exchange's. Configuration, clock activation and
-//! intermediate update modes are never entered: their functions have no state to be called
-//! in.
+//! check), Continuous-Time Mode Model Exchange's. Configuration Mode is fmi2-shell's
+//! [`ConfigurationMode`](fmi2_shell::FmiState::ConfigurationMode), entered from Instantiated
+//! where the model has structural parameters (only fmi3GetUInt64 and fmi3SetUInt64 among the
+//! getters and setters admit it). Reconfiguration, clock activation and intermediate update
+//! modes are never entered: their functions have no state to be called in.
 
 pub mod allowed {
     /// The functions FMI 3.0 keeps, in the same states as FMI 2.0 (fmi3EnterInitializationMode
@@ -15,7 +17,9 @@ pub mod allowed {
         NEW_DISCRETE_STATES as UPDATE_DISCRETE_STATES, RESET, SET, SET_CONTINUOUS_STATES,
         SET_DEBUG_LOGGING, SET_TIME, TERMINATE,
     };
-    use fmi2_shell::state::{ANY, CONTINUOUS, ERROR, EVENT, STEP_COMPLETE, TERMINATED};
+    use fmi2_shell::state::{
+        ANY, CONFIGURATION, CONTINUOUS, ERROR, EVENT, STEP_COMPLETE, TERMINATED,
+    };
     /// From Model Exchange's continuous-time mode, or Co-Simulation's step mode.
     pub const ENTER_EVENT_MODE: u8 = CONTINUOUS | STEP_COMPLETE;
     /// fmi3EnterStepMode: from Co-Simulation's event mode.
@@ -25,8 +29,15 @@ pub mod allowed {
     /// Without clocks there is nothing to evaluate, wherever the importer asks.
     pub const EVALUATE_DISCRETE_STATES: u8 = SET_TIME;
     /// The functions of clocks and configuration mode: admitted in every state, so that their
-    /// body says what is not offered.
+    /// body says what is not offered (and configuration mode's, where it is, which state it
+    /// needs).
     pub const EXPLAINED_REFUSAL: u8 = ANY;
+    /// fmi3GetUInt64 (the structural parameters): wherever values are read, and in
+    /// configuration mode.
+    pub const GET_STRUCTURAL: u8 = GET | CONFIGURATION;
+    /// fmi3SetUInt64: admitted wherever values are set, so that its body says that a
+    /// structural parameter needs configuration mode.
+    pub const SET_STRUCTURAL: u8 = SET | CONFIGURATION;
     /// fmi3GetNumberOf{ContinuousStates,EventIndicators}: constants of the model.
     pub const GET_NUMBER_OF: u8 = ANY;
     pub const GET_OUTPUT_DERIVATIVES: u8 = STEP_COMPLETE | TERMINATED | ERROR;
@@ -62,6 +73,11 @@ mod tests {
             ]
         );
         assert!(!admits(TERMINATE).contains(&Instantiated));
-        assert_eq!(admits(RESET).len(), 7);
+        assert_eq!(admits(RESET).len(), 8);
+        assert!(!admits(SET).contains(&ConfigurationMode));
+        assert!(!admits(GET).contains(&ConfigurationMode));
+        assert!(admits(SET_STRUCTURAL).contains(&ConfigurationMode));
+        assert!(admits(GET_STRUCTURAL).contains(&ConfigurationMode));
+        assert!(!admits(ENTER_INITIALIZATION_MODE).contains(&ConfigurationMode));
     }
 }

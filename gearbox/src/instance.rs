@@ -154,6 +154,39 @@ impl Instance {
         )
     }
 
+    /// A communication step from the master's point `current` (the shell has checked it)
+    /// towards current + h, with `at_impact` ended at the first impact of any gear inside
+    /// it; returns the time reached. A failure leaves the state at `current`.
+    fn step_until(&mut self, current: f64, h: f64, at_impact: bool) -> FmiResult<f64> {
+        let t_end = current + h;
+        let sim = self.sim_mut();
+        sim.t = current;
+        let before = self
+            .log
+            .is_on(EVENTS)
+            .then(|| Self::events(self.sim.as_ref().unwrap()));
+        let sim = self.sim_mut();
+        let finite = |sim: &Simulation| sim.gearbox().1.iter().all(|v| v.is_finite());
+        match sim.step_until(t_end, at_impact) {
+            Ok(_) if !finite(sim) => Err(FmiError::error(format!(
+                "fmi2DoStep from t = {current} to {t_end} failed: the state is no longer finite (times, steps or inputs beyond what the model can represent); fmi2Reset to start over"
+            ))),
+            Ok(reached) => {
+                self.sync_inputs();
+                if let Some(before) = before {
+                    self.log_events(reached, before);
+                }
+                if self.log.is_on(STEPS) {
+                    self.log_steps(reached);
+                }
+                Ok(reached)
+            }
+            Err(e) => Err(FmiError::error(format!(
+                "fmi2DoStep from t = {current} to {t_end} failed: {e}; the state stays at t = {current}"
+            ))),
+        }
+    }
+
     /// logStep after a step: the solver's work so far.
     fn log_steps(&mut self, t_end: f64) {
         let sim = self.sim.as_ref().expect("initialised");
@@ -281,33 +314,14 @@ impl Slave for Instance {
     /// One communication step from the master's point `current`; a failure leaves the
     /// state at `current`.
     fn step(&mut self, current: f64, h: f64) -> FmiResult {
-        let t_end = current + h;
-        let sim = self.sim_mut();
-        sim.t = current;
-        let before = self
-            .log
-            .is_on(EVENTS)
-            .then(|| Self::events(self.sim.as_ref().unwrap()));
-        let sim = self.sim_mut();
-        let finite = |sim: &Simulation| sim.gearbox().1.iter().all(|v| v.is_finite());
-        match sim.step_to(t_end) {
-            Ok(()) if !finite(sim) => Err(FmiError::error(format!(
-                "fmi2DoStep from t = {current} to {t_end} failed: the state is no longer finite (times, steps or inputs beyond what the model can represent); fmi2Reset to start over"
-            ))),
-            Ok(()) => {
-                self.sync_inputs();
-                if let Some(before) = before {
-                    self.log_events(t_end, before);
-                }
-                if self.log.is_on(STEPS) {
-                    self.log_steps(t_end);
-                }
-                Ok(())
-            }
-            Err(e) => Err(FmiError::error(format!(
-                "fmi2DoStep from t = {current} to {t_end} failed: {e}; the state stays at t = {current}"
-            ))),
-        }
+        self.step_until(current, h, false).map(|_| ())
+    }
+
+    /// Early return (FMI 3.0): the step ends at the first impact of any gear inside it.
+    const STEPS_TO_EVENTS: bool = true;
+
+    fn step_to_event(&mut self, current: f64, h: f64) -> FmiResult<f64> {
+        self.step_until(current, h, true)
     }
 
     // Model Exchange (see `crate::model_exchange`).

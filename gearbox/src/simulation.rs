@@ -140,6 +140,14 @@ fn drive(values: &Values, params: &GearboxParams, t0: f64) -> Drive {
     }
 }
 
+/// The impacts of every gear so far, both flanks (the slots beyond n_gears have none).
+fn impacts(g: &Gearbox) -> u64 {
+    g.gears
+        .iter()
+        .map(|g| g.impacts.count.iter().sum::<u64>())
+        .sum()
+}
+
 /// `$body` with `$k` the stepped system of `$run`, whichever it is.
 macro_rules! on_run {
     ($run:expr, $k:ident => $body:expr) => {
@@ -206,27 +214,39 @@ impl Simulation {
         self.run = Run::Windowed(Box::new(Stepped { system, solver, y }));
     }
 
-    /// Advances to t_end, through the window's opening on the way. On failure the
+    /// Advances to t_end, through the window's opening on the way, with `at_impact` stopping
+    /// at the first impact (contact onset) of any gear on the way, where the integrator
+    /// locates it ([`Solver::advance_until`]); returns the time reached. On failure the
     /// simulation is left as it was.
-    pub fn step_to(&mut self, t_end: f64) -> Result<(), SolverError> {
-        if matches!(self.run, Run::Lean(_)) && self.window_from <= t_end {
+    pub fn step_until(&mut self, t_end: f64, at_impact: bool) -> Result<f64, SolverError> {
+        let stopped = if matches!(self.run, Run::Lean(_)) && self.window_from <= t_end {
             let before = self.clone();
-            let opened = self
-                .advance_to(self.window_from)
-                .map(|()| self.open_window());
-            if let Err(e) = opened.and_then(|()| self.advance_to(t_end)) {
-                *self = before;
-                return Err(e);
-            }
+            let advanced = self
+                .advance_until(self.window_from, at_impact)
+                .and_then(|stopped| {
+                    if stopped {
+                        return Ok(true);
+                    }
+                    self.open_window();
+                    self.advance_until(t_end, at_impact)
+                });
+            advanced.inspect_err(|_| *self = before)?
         } else {
-            self.advance_to(t_end)?;
+            self.advance_until(t_end, at_impact)?
+        };
+        if !stopped {
+            self.t = t_end;
         }
-        self.t = t_end;
-        Ok(())
+        Ok(self.t)
     }
 
-    fn advance_to(&mut self, t_end: f64) -> Result<(), SolverError> {
-        on_run!(&mut self.run, k => k.advance_to(&mut self.t, t_end))
+    /// The run's advance to t_end, stopping at an impact if `at_impact`: true if it did.
+    fn advance_until(&mut self, t_end: f64, at_impact: bool) -> Result<bool, SolverError> {
+        let on = u64::from(at_impact);
+        match &mut self.run {
+            Run::Lean(k) => k.advance_until(&mut self.t, t_end, |g| on * impacts(g)),
+            Run::Windowed(k) => k.advance_until(&mut self.t, t_end, |w| on * impacts(&w.inner)),
+        }
     }
 
     /// The gearbox and its state now, as the outputs read them: in Model Exchange with the

@@ -13,6 +13,7 @@ import pytest
 from fmpy import read_model_description, simulate_fmu
 from fmpy.fmi1 import FMICallException
 from fmpy.fmi3 import FMU3Model, FMU3Slave
+from support.early_return import step_to_impacts
 from support.fmu import BUILD_FMU3, FMU3_PATH, FMU_PATH, OUTPUTS, main_shaft_input, session_fixtures
 
 from gearrattle import reference as R
@@ -167,32 +168,13 @@ def stepped_to_impacts(md3, unzipdir3, event_mode):
     fmu = started(md3, unzipdir3, "early", earlyReturnAllowed=True, eventModeUsed=event_mode)
     counts = [vr_of(md3, "impacts_Fplus"), vr_of(md3, "impacts_Fminus")]
     xi = [vr_of(md3, "xi"), vr_of(md3, "xi_dot")]
-    if event_mode:
-        # eventModeUsed: initialisation ends in event mode.
-        assert fmu.updateDiscreteStates()[0] is False
-        fmu.enterStepMode()
-    t, k, returned, at_return, grid = 0.0, 1, [], [], []
-    while k <= round(EARLY_T_END / EARLY_H):
-        event, terminate, early, last = fmu.doStep(t, k * EARLY_H - t)
-        assert (event, terminate) == (early and event_mode, False)
-        if early:
-            assert t < last < k * EARLY_H
-            if event_mode:
-                fmu.enterEventMode()
-            returned.append(last)
-            at_return.append((fmu.getFloat64(xi[:1])[0], sum(fmu.getInt32(counts))))
-            if event_mode:
-                fmu.updateDiscreteStates()
-                fmu.enterStepMode()
-        else:
-            assert last == k * EARLY_H
-            grid.append(fmu.getFloat64(xi))
-            k += 1
-        t = last
+    returned, at_return, grid = step_to_impacts(
+        fmu, EARLY_T_END, EARLY_H, event_mode,
+        lambda: (fmu.getFloat64(xi[:1])[0], sum(fmu.getInt32(counts))), lambda: fmu.getFloat64(xi))
     total = sum(fmu.getInt32(counts))
     fmu.terminate()
     fmu.freeInstance()
-    return np.array(returned), at_return, total, np.array(grid)
+    return returned, at_return, total, grid
 
 
 @pytest.mark.parametrize("event_mode", [False, True], ids=["early return", "event mode"])

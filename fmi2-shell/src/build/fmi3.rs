@@ -2,12 +2,18 @@
 //! variables, units and capabilities in FMI 3.0's terms.
 //!   - Types: Real is Float64; Integer is Int32, or an Enumeration where the contract lists
 //!     its `items` (declared under TypeDefinitions, named as the variable, an array's
-//!     variable by its declared name: one type for `gear[1].contact` .. `gear[8].contact`).
+//!     variable by its declared name: one type `contact` for `gear.contact`).
+//!   - Arrays: each variable of an `[[array]]` once, named `ARRAY.NAME` (`gear.xi`,
+//!     `der(gear.xi)`), with one `<Dimension>` whose length is the structural parameter
+//!     `n_ARRAYs` (UInt64, causality structuralParameter, variability fixed: set in
+//!     configuration mode), its start the first `n_ARRAYs` elements' starts; reference
+//!     `vr_base + offset` ([`crate::contract::fmi3::Array`]).
 //!   - Value references: one space for all variables ([`crate::contract::fmi3`]); the
 //!     independent variable `time` and Model Exchange's event indicators (Float64 locals
 //!     `event_indicator_k`) are declared beside the contract's.
 //!   - ModelStructure: Output, ContinuousStateDerivative, InitialUnknown and EventIndicator
-//!     elements by value reference.
+//!     elements by value reference (an array's once: the states are phi, x_omega_I, then
+//!     every gear's xi, then every gear's xi_dot).
 //!   - Capabilities renamed where FMI 3.0 renamed them, dropped where it has none (and
 //!     canInterpolateInputs: FMI 3.0 has no fmi3SetInputDerivatives), and the adjoint
 //!     derivatives wherever the directional ones are offered (fmi3-shell computes them from
@@ -15,28 +21,104 @@
 //!     false); no early return after an intermediate update (there is none).
 
 use super::{
-    Contract, Variable, attributes, esc, initial_unknowns, log_categories_and_experiment, units,
-    value, variable_head,
+    Array, Contract, Variable, attributes, esc, initial_unknowns, log_categories_and_experiment,
+    units, value, variable_head,
 };
 use crate::contract::fmi3::{EVENT_INDICATOR_VR, INTEGER_VR_OFFSET, TIME_VR};
 use std::fmt::Write as _;
 
-/// A variable's FMI 3.0 value reference.
-fn vr(v: &Variable) -> u32 {
+/// The contract's array named `name`.
+fn array<'c>(c: &'c Contract, name: &str) -> &'c Array {
+    c.array
+        .iter()
+        .find(|a| a.name == name)
+        .expect("expanded from an array")
+}
+
+/// The array whose length the variable gives, if it is a structural parameter.
+fn sized_by<'c>(c: &'c Contract, v: &Variable) -> Option<&'c Array> {
+    c.array.iter().find(|a| a.size_parameter() == v.name)
+}
+
+/// A variable's FMI 3.0 value reference: an array element's is its array variable's.
+fn vr(c: &Contract, v: &Variable) -> u32 {
     assert!(
         v.vr < INTEGER_VR_OFFSET,
         "{}: value reference {} is not below {INTEGER_VR_OFFSET} (FMI 3.0's Integer offset)",
         v.name,
         v.vr
     );
+    let own = match &v.element {
+        Some(e) => v.vr - array(c, &e.array).vr_stride * e.index as u32,
+        None => v.vr,
+    };
     match v.ty.as_str() {
-        "Integer" => v.vr + INTEGER_VR_OFFSET,
-        _ => v.vr,
+        "Integer" => own + INTEGER_VR_OFFSET,
+        _ => own,
     }
 }
 
+/// The variables as FMI 3.0 declares them: an array's once (its element 1 renamed, without
+/// start: [`array_start`]), a structural parameter as such.
+fn declared(c: &Contract) -> Vec<Variable> {
+    c.variable
+        .iter()
+        .filter(|v| v.element.as_ref().is_none_or(|e| e.index == 1))
+        .map(|v| match (&v.element, sized_by(c, v)) {
+            (Some(e), _) => {
+                let name = match e.declared.strip_prefix("der(").and_then(|n| n.strip_suffix(')')) {
+                    Some(state) => format!("der({}.{state})", e.array),
+                    None => format!("{}.{}", e.array, e.declared),
+                };
+                Variable {
+                    name,
+                    start: None,
+                    ..v.clone()
+                }
+            }
+            (None, Some(a)) => Variable {
+                causality: "structuralParameter".into(),
+                description: format!(
+                    "Length of the {0}.* arrays: {0}s 1..{1} (structural parameter, set in configuration mode)",
+                    a.name,
+                    a.size_parameter()
+                ),
+                ..v.clone()
+            },
+            (None, None) => v.clone(),
+        })
+        .collect()
+}
+
+/// An array variable's start: its first elements' starts (as many as the structural
+/// parameter's start), where the contract gives them.
+fn array_start(c: &Contract, v: &Variable) -> Option<String> {
+    let e = v.element.as_ref()?;
+    let n = c
+        .variable
+        .iter()
+        .find(|w| w.name == array(c, &e.array).size_parameter())
+        .and_then(|w| w.start.as_ref())
+        .and_then(toml::Value::as_integer)
+        .expect("an Integer start") as usize;
+    let starts: Option<Vec<String>> = c
+        .variable
+        .iter()
+        .filter(|w| {
+            w.element
+                .as_ref()
+                .is_some_and(|f| f.array == e.array && f.declared == e.declared && f.index <= n)
+        })
+        .map(|w| w.start.as_ref().map(value))
+        .collect();
+    starts.map(|s| s.join(" "))
+}
+
 /// A variable's FMI 3.0 element name.
-fn type_name(v: &Variable) -> &'static str {
+fn type_name(c: &Contract, v: &Variable) -> &'static str {
+    if sized_by(c, v).is_some() {
+        return "UInt64";
+    }
     match (v.ty.as_str(), &v.items) {
         ("Real", _) => "Float64",
         ("Integer", Some(_)) => "Enumeration",
@@ -96,11 +178,15 @@ pub(super) fn xml(c: &Contract, token: &str) -> String {
     let mut x = String::new();
     let m = &c.model;
     let by_name = |name: &str| {
-        vr(c.variable
-            .iter()
-            .find(|w| w.name == name)
-            .unwrap_or_else(|| panic!("no variable {name}")))
+        vr(
+            c,
+            c.variable
+                .iter()
+                .find(|w| w.name == name)
+                .unwrap_or_else(|| panic!("no variable {name}")),
+        )
     };
+    let variables = declared(c);
     x += "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
     writeln!(
         x,
@@ -124,8 +210,7 @@ pub(super) fn xml(c: &Contract, token: &str) -> String {
     );
     units(&mut x, c);
     let mut declared = std::collections::BTreeSet::new();
-    let enumerations: Vec<&Variable> = c
-        .variable
+    let enumerations: Vec<&Variable> = variables
         .iter()
         .filter(|v| v.items.is_some() && declared.insert(enumeration_type(v)))
         .collect();
@@ -153,15 +238,29 @@ pub(super) fn xml(c: &Contract, token: &str) -> String {
         "    <Float64 name=\"time\" valueReference=\"{TIME_VR}\" description=\"Simulation time\" causality=\"independent\" variability=\"continuous\" unit=\"s\"/>"
     )
     .unwrap();
-    for v in &c.variable {
-        variable_head(&mut x, type_name(v), v, vr(v));
+    for v in &variables {
+        let element = type_name(c, v);
+        variable_head(&mut x, element, v, vr(c, v));
         if let Some(name) = v.items.as_ref().map(|_| enumeration_type(v)) {
             write!(x, " declaredType=\"{name}\"").unwrap();
         }
         // An enumeration's range is its items.
         let derivative = v.derivative_of.as_deref().map(|s| by_name(s).to_string());
         attributes(&mut x, v, v.items.is_none(), derivative);
-        x += "/>\n";
+        match &v.element {
+            None => x += "/>\n",
+            Some(e) => {
+                if let Some(start) = array_start(c, v) {
+                    write!(x, " start=\"{start}\"").unwrap();
+                }
+                let n = by_name(&array(c, &e.array).size_parameter());
+                writeln!(
+                    x,
+                    ">\n      <Dimension valueReference=\"{n}\"/>\n    </{element}>"
+                )
+                .unwrap();
+            }
+        }
     }
     for k in 0..m.event_indicators {
         writeln!(
@@ -178,11 +277,12 @@ pub(super) fn xml(c: &Contract, token: &str) -> String {
     let unknown = |x: &mut String, element: &str, v: &Variable| {
         let mut deps: Vec<u32> = v.depends_on.iter().flatten().map(|d| by_name(d)).collect();
         deps.sort();
+        deps.dedup();
         let deps: Vec<String> = deps.iter().map(u32::to_string).collect();
         write!(
             x,
             "    <{element} valueReference=\"{}\" dependencies=\"{}\"",
-            vr(v),
+            vr(c, v),
             deps.join(" ")
         )
         .unwrap();
@@ -192,13 +292,11 @@ pub(super) fn xml(c: &Contract, token: &str) -> String {
         }
         x.push_str("/>\n");
     };
-    let outputs: Vec<&Variable> = c
-        .variable
+    let outputs: Vec<&Variable> = variables
         .iter()
         .filter(|v| v.causality == "output")
         .collect();
-    let derivatives: Vec<&Variable> = c
-        .variable
+    let derivatives: Vec<&Variable> = variables
         .iter()
         .filter(|v| v.derivative_of.is_some())
         .collect();
