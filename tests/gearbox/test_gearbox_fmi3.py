@@ -18,8 +18,8 @@ from support.fmu import session_fixtures
 
 GEARBOX_FMU3_PATH = GF.ROOT / "target" / "fmu" / "fmi3" / "GearboxRattle.fmu"
 BUILD_GEARBOX_FMU3 = (
-    "`make fmu` (or `cargo run --release -p packaging -- --model GearboxRattle --fmi 3 --lib "
-    "target/release/libgearbox_rattle.so`)"
+    "`make fmu` (or `cargo build --release -p gearbox_rattle_fmu && cargo run --profile quick -p packaging -- "
+    "--model GearboxRattle --fmi 3 --lib target/release/libgearbox_rattle_fmu.so --out target/fmu/fmi3/GearboxRattle.fmu`)"
 )
 
 
