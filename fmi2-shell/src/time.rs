@@ -21,32 +21,42 @@ enum StepRefusal {
 /// the spacing of doubles is 1.2e-7 s), and is refused rather than stretched or shrunk.
 #[inline]
 pub fn check_step(current: f64, h: f64, t: f64) -> FmiResult {
-    match refusal(current, h, t) {
-        None => Ok(()),
-        Some(why) => Err(step_refused(why, current, h, t)),
+    match accepted(current, h, t) {
+        true => Ok(()),
+        false => Err(step_refused(current, h, t)),
     }
 }
 
+/// The three tests of [`check_step`] in plain comparisons, run at every fmi2DoStep: each is
+/// written so that a NaN fails it (a comparison with NaN is false), and an infinite h or
+/// current fails the drift or the resolution test (∞ − ∞ is NaN), t being finite (the start
+/// time, then the ends of accepted steps). `is_finite` and `f64::max` would cost several
+/// times these instructions; the reason of a refusal is sought apart ([`refusal`]).
 #[inline]
-fn refusal(current: f64, h: f64, t: f64) -> Option<StepRefusal> {
-    if !(h > 0.0 && h.is_finite()) {
-        return Some(StepRefusal::Size);
-    }
-    if !current.is_finite() || (current - t).abs() > 1e-9 * t.abs().max(h).max(1e-3) {
-        return Some(StepRefusal::Time);
-    }
+fn accepted(current: f64, h: f64, t: f64) -> bool {
+    let t_abs = t.abs();
+    let scale = if h > t_abs { h } else { t_abs };
+    let scale = if scale > 1e-3 { scale } else { 1e-3 };
     let resolved = (current + h) - current;
-    if (resolved - h).abs() > 1e-3 * h {
-        return Some(StepRefusal::Resolution(resolved));
+    h > 0.0 && (current - t).abs() <= 1e-9 * scale && (resolved - h).abs() <= 1e-3 * h
+}
+
+/// Why [`accepted`] refuses a step: the first test it fails.
+fn refusal(current: f64, h: f64, t: f64) -> StepRefusal {
+    if !(h > 0.0 && h.is_finite()) {
+        return StepRefusal::Size;
     }
-    None
+    if !current.is_finite() || !((current - t).abs() <= 1e-9 * t.abs().max(h).max(1e-3)) {
+        return StepRefusal::Time;
+    }
+    StepRefusal::Resolution((current + h) - current)
 }
 
 /// The message of a refused step (kept off the path of a valid one).
 #[cold]
 #[inline(never)]
-fn step_refused(why: StepRefusal, current: f64, h: f64, t: f64) -> FmiError {
-    FmiError::error(match why {
+fn step_refused(current: f64, h: f64, t: f64) -> FmiError {
+    FmiError::error(match refusal(current, h, t) {
         StepRefusal::Size => format!(
             "communicationStepSize = {h:e} at t = {current} refused: it must be finite and > 0"
         ),
@@ -103,10 +113,50 @@ mod tests {
         assert!(refused(0.0, f64::INFINITY, 0.0).contains("finite and > 0"));
         assert!(refused(1.0, 1e-3, 0.5).contains("does not match"));
         assert!(refused(f64::NAN, 1e-3, 0.5).contains("does not match"));
+        assert!(refused(f64::NEG_INFINITY, 1e-3, 0.5).contains("does not match"));
+        assert!(refused(-1e-3, f64::NAN, 0.0).contains("finite and > 0"));
         assert!(refused(1e9, 1e-7, 1e9).contains("resolution of time"));
         let drifted = (0..1000).fold(0.0, |t, _| t + 1e-4);
         check_step(drifted, 1e-4, 0.1).unwrap();
         check_step(0.1, 1e-4, drifted).unwrap();
+    }
+
+    /// The comparisons of the accepted path agree with the tests written with `is_finite`
+    /// and `f64::max`, over finite, infinite and NaN arguments and the edges of each test.
+    #[test]
+    fn the_fast_test_agrees_with_the_plain_one() {
+        let values = [
+            0.0,
+            -0.0,
+            1e-300,
+            1e-9,
+            1e-4,
+            1e-3,
+            0.1,
+            0.1 + 1e-12,
+            0.5,
+            1.0,
+            1e9,
+            1e9 + 1e-7,
+            -1e-4,
+            -1.0,
+            f64::MAX,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NAN,
+        ];
+        for &current in &values {
+            for &h in &values {
+                for t in values.into_iter().filter(|t| t.is_finite()) {
+                    let plain = h > 0.0
+                        && h.is_finite()
+                        && current.is_finite()
+                        && (current - t).abs() <= 1e-9 * t.abs().max(h).max(1e-3)
+                        && (((current + h) - current) - h).abs() <= 1e-3 * h;
+                    assert_eq!(accepted(current, h, t), plain, "{current} {h} {t}");
+                }
+            }
+        }
     }
 
     #[test]
