@@ -46,7 +46,7 @@ fn refusal(current: f64, h: f64, t: f64) -> StepRefusal {
     if !(h > 0.0 && h.is_finite()) {
         return StepRefusal::Size;
     }
-    if !current.is_finite() || !((current - t).abs() <= 1e-9 * t.abs().max(h).max(1e-3)) {
+    if !current.is_finite() || (current - t).abs() > 1e-9 * t.abs().max(h).max(1e-3) {
         return StepRefusal::Time;
     }
     StepRefusal::Resolution((current + h) - current)
