@@ -134,6 +134,11 @@ impl<S: GearPair<N> + Jacobian<N> + Copy, const N: usize> Stepped<S, N> {
         self.system.window_mut().open(q);
     }
 
+    /// ξ and ξ'.
+    fn xi(&self) -> [f64; 2] {
+        [self.y[S::XI], self.y[S::XI_DOT]]
+    }
+
     fn now(&self) -> Now<'_> {
         let (sys, y) = (&self.system, &self.y);
         Now {
@@ -539,6 +544,12 @@ impl Simulation {
 
     /// The value of a Real output, computed now; None if `vr` is not a Real output.
     pub fn real_output(&self, vr: u32) -> Option<f64> {
+        // ξ and ξ' straight from the state: fmi2DoStep reads them after every step.
+        match vr {
+            vr::xi => return Some(on_gear!(&self.gear, k => k.xi()[0])),
+            vr::xi_dot => return Some(on_gear!(&self.gear, k => k.xi()[1])),
+            _ => {}
+        }
         let now = self.now();
         self.real_output_with(vr, &now, || self.shaft(), || now.loads(&self.shaft()))
     }
