@@ -6,7 +6,7 @@
 # masters' PyPI packages are pinned in requirements.txt.
 
 FLYWHEEL_FMU := target/fmu/Flywheel.fmu
-FLYWHEEL_LIB := target/release/libflywheel.so
+FLYWHEEL_LIB := target/quick/libflywheel.so
 
 TEST_TARGETS += test-flywheel
 
@@ -15,9 +15,10 @@ TEST_TARGETS += test-flywheel
 ## flywheel-fmu: build target/fmu/Flywheel.fmu, the drivetrain partner (linux64)
 flywheel-fmu: $(FLYWHEEL_FMU)
 
-# cargo decides what to rebuild; the model description is written from src/model.rs.
+# cargo decides what to rebuild; the model description is written from src/model.rs. A test
+# partner, built in the tests' `quick` profile (Cargo.toml): no release build of its own.
 $(FLYWHEEL_FMU): FORCE
-	cargo build --release -p flywheel
+	cargo build --profile quick -p flywheel
 	$(PACKAGE) --model Flywheel --lib $(FLYWHEEL_LIB) --out $@
 
 # The master tests live in pytest's testpaths: `make test-python` runs them, so it needs
