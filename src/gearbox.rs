@@ -220,8 +220,9 @@ impl Gearbox {
         self.n
     }
 
-    /// Whether ω_F is a state (an engine ramp).
-    fn integrates_flywheel(&self) -> bool {
+    /// Whether ω_F and θ_F are states (an engine ramp): ω_F in slot [`omega_F`] of the n
+    /// gears, θ_F in [`THETA_F`].
+    pub fn integrates_flywheel(&self) -> bool {
         matches!(self.drive, Drive::Engine(e) if !e.is_steady())
     }
 

@@ -961,9 +961,9 @@ mod tests {
         assert!(xml.contains("<Unit name=\"degC\"><BaseUnit K=\"1\" offset=\"273.15\"/>"));
         let e = scalar(&xml, "n_gears");
         assert!(e.contains("min=\"1\" max=\"8\""), "{e}");
-        // The state vector: phi, x_omega_I, then each gear's xi and xi_dot.
+        // The state vector: phi, x_omega_I, x_theta_F, x_omega_F, then each gear's xi and xi_dot.
         assert!(rust.contains(
-            "pub const STATES: &[u32] = &[45, 80, 1120, 1121, 1220, 1221, 1320, 1321, 1420, 1421, 1520, 1521, 1620, 1621, 1720, 1721, 1820, 1821];"
+            "pub const STATES: &[u32] = &[45, 80, 81, 82, 1120, 1121, 1220, 1221, 1320, 1321, 1420, 1421, 1520, 1521, 1620, 1621, 1720, 1721, 1820, 1821];"
         ));
         assert!(rust.contains(
             "pub const I_L: [u32; 8] = [1101, 1201, 1301, 1401, 1501, 1601, 1701, 1801];"
@@ -1052,7 +1052,7 @@ mod tests {
         assert_eq!(vr::gear::locate(vr::n_gears), None);
         assert_eq!(contract::find(Kind::Real, vr::gear::G[0]).unwrap().name, "gear[1].G");
         assert_eq!(contract::find(Kind::Integer, vr::gear::contact[7]).unwrap().name, "gear[8].contact");
-        assert_eq!(contract::STATES.len(), 18);
+        assert_eq!(contract::STATES.len(), 20);
         assert_eq!(contract::EVENT_INDICATORS, 42);
         let mut values = Values::start(VARIABLES);
         assert!(contract::check_parameters(&values).is_ok());

@@ -3,26 +3,31 @@
 //! and statistics windows) as co-simulation, whose own solver then stays idle.
 //!
 //! States (the contract's `STATES`): φ, the input side's speed ω_I (the model integrates
-//! φ' = ω_F − ω_I: ω_I = ω_F(t) − φ'), then each gear slot's ξ and ξ' (a slot beyond n_gears
-//! is unused and constant). Event indicators: per gear slot the contact law's edges ξ + ε,
-//! ξ, ξ − G, ξ − G − ε and ξ' in the gap (its turning points), then the damper's stage edges
-//! φ − φ_1 and φ + φ_1. The derivatives take the formulas of the pieces the states are in;
-//! at an event the gearbox's stage and regions follow them across the edges (an onset counts
-//! an impact and enters the statistics), as the co-simulation's solver does. The energies
-//! and the window's integrals are not states of the contract: in Model Exchange they stay at
-//! their start, and so do the statistics made of them.
+//! φ' = ω_F − ω_I: ω_I = ω_F(t) − φ'), the flywheel's θ_F and ω_F under an engine ramp (their
+//! derivatives ω_F and α_F(t): docs/GEARBOX.md §4 has no closed form for them; at a steady
+//! speed or driven by inputs the two are unused, 0), then each gear slot's ξ and ξ' (a slot
+//! beyond n_gears is unused, 0). An unused state's derivative is 0. Event indicators: per
+//! gear slot the contact law's edges ξ + ε, ξ, ξ − G, ξ − G − ε and ξ' in the gap (its
+//! turning points), then the damper's stage edges φ − φ_1 and φ + φ_1. The derivatives take
+//! the formulas of the pieces the states are in; at an event the gearbox's stage and regions
+//! follow them across the edges (an onset counts an impact and enters the statistics), as
+//! the co-simulation's solver does. The energies and the window's integrals are not states
+//! of the contract: in Model Exchange they stay at their start, and so do the statistics
+//! made of them.
 #![allow(non_snake_case)]
 
 use crate::contract::{EVENT_INDICATORS, STATES};
 use crate::simulation::{Run, Simulation};
 use crate::windowed;
 use fmi2_shell::Continuous;
-use gear_rattle::gearbox::{Drive, Gearbox, MAX_GEARS, PHI, PHI_DOT, State, xi, xi_dot};
+use gear_rattle::gearbox::{
+    Drive, Gearbox, MAX_GEARS, PHI, PHI_DOT, State, THETA_F, omega_F, xi, xi_dot,
+};
 use gear_rattle::integrator::{Piecewise, System};
 use gear_rattle::physics::{Polynomial, Region, Shaft};
 
 /// Number of continuous states.
-pub const NX: usize = 2 + 2 * MAX_GEARS;
+pub const NX: usize = 4 + 2 * MAX_GEARS;
 const _: () = assert!(STATES.len() == NX);
 /// Number of event indicators.
 pub const NZ: usize = EVENT_INDICATORS;
@@ -31,8 +36,10 @@ const _: () = assert!(NZ == 5 * MAX_GEARS + 2);
 /// State x's components.
 const X_PHI: usize = 0;
 const X_OMEGA_I: usize = 1;
+const X_THETA_F: usize = 2;
+const X_OMEGA_F: usize = 3;
 const fn x_xi(i: usize) -> usize {
-    2 + 2 * i
+    4 + 2 * i
 }
 
 impl Continuous for Simulation {
@@ -47,20 +54,27 @@ impl Continuous for Simulation {
             x[X_PHI] = y[PHI];
             x[X_OMEGA_I] = g.flywheel_at(self.t, &y).omega - y[PHI_DOT];
         }
-        for i in 0..MAX_GEARS {
+        if g.integrates_flywheel() {
+            (x[X_THETA_F], x[X_OMEGA_F]) = (y[THETA_F], y[omega_F(g.n_gears())]);
+        }
+        for i in 0..g.n_gears() {
             (x[x_xi(i)], x[x_xi(i) + 1]) = (y[xi(i)], y[xi_dot(i)]);
         }
         x
     }
 
-    /// Takes the importer's states x: φ' follows from ω_I and the flywheel's speed now.
+    /// Takes the importer's states x (the unused ones ignored): φ' follows from ω_I and the
+    /// flywheel's speed now, which under a ramp is the state ω_F.
     fn set_continuous_states(&mut self, x: &[f64; NX]) {
         self.change_state(|g, t, y| {
+            if g.integrates_flywheel() {
+                (y[THETA_F], y[omega_F(g.n_gears())]) = (x[X_THETA_F], x[X_OMEGA_F]);
+            }
             if !matches!(g.drive, Drive::InputSide(_)) {
                 y[PHI] = x[X_PHI];
                 y[PHI_DOT] = g.flywheel_at(t, y).omega - x[X_OMEGA_I];
             }
-            for i in 0..MAX_GEARS {
+            for i in 0..g.n_gears() {
                 (y[xi(i)], y[xi_dot(i)]) = (x[x_xi(i)], x[x_xi(i) + 1]);
             }
         });
@@ -75,18 +89,22 @@ impl Continuous for Simulation {
             dx[X_PHI] = f[PHI];
             dx[X_OMEGA_I] = g.readout(self.t, &y).input.alpha_I;
         }
+        if g.integrates_flywheel() {
+            (dx[X_THETA_F], dx[X_OMEGA_F]) = (f[THETA_F], f[omega_F(g.n_gears())]);
+        }
         for i in 0..g.n_gears() {
             (dx[x_xi(i)], dx[x_xi(i) + 1]) = (f[xi(i)], f[xi_dot(i)]);
         }
         dx
     }
 
-    /// Nominal magnitudes: φ on the scale of φ_1, ω_I of 100 rad/s, each ξ of its backlash
-    /// and ξ' of a backlash per millisecond.
+    /// Nominal magnitudes: φ on the scale of φ_1, ω_I and ω_F of 100 rad/s, θ_F of 100 rad
+    /// (a second at idle), each ξ of its backlash and ξ' of a backlash per millisecond.
     fn nominals(&self) -> [f64; NX] {
         let (g, _) = self.gearbox();
         let mut x = [1.0; NX];
         (x[X_PHI], x[X_OMEGA_I]) = (g.damper.params.phi_1, 100.0);
+        (x[X_THETA_F], x[X_OMEGA_F]) = (100.0, 100.0);
         for (i, gear) in g.gears.iter().enumerate() {
             let G = gear.dynamics.params.G;
             (x[x_xi(i)], x[x_xi(i) + 1]) = (G, G * 1e3);

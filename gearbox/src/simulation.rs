@@ -165,12 +165,6 @@ impl Simulation {
     pub fn new(values: &Values, t0: f64, rtol: f64, model_exchange: bool) -> FmiResult<Self> {
         contract::check_parameters(values)?;
         let params = params(values);
-        if model_exchange && params.engine.rpm_rate != 0.0 {
-            return Err(FmiError::error(format!(
-                "rpm_rate = {:e} refused in Model Exchange: the ramped engine's angle and speed are states of co-simulation only; set rpm_rate = 0 or use Co-Simulation",
-                params.engine.rpm_rate
-            )));
-        }
         let drive = drive(values, &params, t0);
         let (_, mut y) = Gearbox::start(&params, drive)
             .map_err(|e| FmiError::error(format!("{e}: nothing runs on an invalid gearbox")))?;

@@ -120,13 +120,15 @@ fn outputs_move_with_inputs_only_where_declared() {
         .unwrap();
 }
 
-/// Model Exchange at the start with every gear in contact: each continuous state, and each
-/// input of the drive, moves only the outputs and derivatives that name it.
+/// Model Exchange at the start with every gear in contact, for each drive and the engine
+/// ramped: each continuous state, and each input of the drive, moves only the outputs and
+/// derivatives that name it.
 #[test]
 fn model_exchange_moves_only_where_declared() {
-    for excitation in [0, 1, 2] {
+    for (excitation, rpm_rate) in [(0, 0.0), (1, 0.0), (1, -150.0), (2, 0.0)] {
         let mut values = Values::start(VARIABLES);
         values.set_integer(vr::excitation, excitation);
+        values.set_real(vr::rpm_rate, rpm_rate);
         for g in vr::gear::gap_start {
             values.set_real(g, -0.2);
         }

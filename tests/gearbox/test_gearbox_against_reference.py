@@ -32,11 +32,7 @@ def _runs(box_run, box_md, scene, fmi_type):
     return fmu, ref, ix
 
 
-# The ramped engine's angle and speed are states of co-simulation only: Model Exchange
-# refuses rpm_rate != 0.
-RUN_DOWN_ME = pytest.param("R1", "ModelExchange", marks=pytest.mark.xfail(
-    strict=True, reason="GearboxRattle's Model Exchange refuses rpm_rate != 0 (the ramp is CS-only)"))
-BOTH = [(s, f) for s in ("B1", "B2") for f in ("CoSimulation", "ModelExchange")] + [("R1", "CoSimulation"), RUN_DOWN_ME]
+BOTH = [(s, f) for s in ("B1", "B2", "R1") for f in ("CoSimulation", "ModelExchange")]
 
 
 @pytest.mark.parametrize("scene,fmi_type", BOTH)
@@ -58,7 +54,7 @@ def test_impact_counts_over_window(box_run, box_md, scene, fmi_type):
     assert np.array_equal(got, want), f"{scene} {fmi_type}: the counts differ at some samples"
 
 
-@pytest.mark.parametrize("scene,fmi_type", [b for b in BOTH if getattr(b, "values", b)[0] != "B2"])
+@pytest.mark.parametrize("scene,fmi_type", [b for b in BOTH if b[0] != "B2"])
 def test_impact_rates_beyond_window(box_run, box_md, scene, fmi_type):
     fmu, ref, _ = _runs(box_run, box_md, scene, fmi_type)
     t = fmu["time"]

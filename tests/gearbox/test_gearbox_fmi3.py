@@ -68,7 +68,7 @@ def test_validates_with_enumerations_and_arrays(box3_path, box3_md, box_md):
         declared = name.replace("gear.", "gear[{}].")
         if fmi2[declared.format(1)].start is not None:
             assert var[name].start.split() == [fmi2[declared.format(i)].start for i in range(1, 6)], name
-    assert len(box3_md.derivatives) == 4 and box3_md.numberOfContinuousStates == 2 + 2 * 5
+    assert len(box3_md.derivatives) == 6 and box3_md.numberOfContinuousStates == 4 + 2 * 5
     assert len(box3_md.eventIndicators) == 42
     # The same variables as the FMI 2.0 FMU's, the gears' as arrays, besides the time and the
     # event indicators.
@@ -146,12 +146,13 @@ def test_co_simulation_equals_fmi2_to_the_bit(box_run, box3_unzipdir, box3_md):
         np.testing.assert_array_equal(fmi2_gears(fmi2, field, 5), fmi3[f"gear.{field}"], err_msg=field)
 
 
-def test_model_exchange_agrees_with_fmi2_within_the_tolerance(box_run, box3_unzipdir, box3_md):
-    """fmpy's CVode at rtol 1e-12, as the FMI 2.0 Model Exchange tests run it: xi within
-    1e-4 G_i and the same impact counts (FMI 3.0's state vector holds the gears' xi, then
-    their xi_dot)."""
-    fmi2 = box_run(0.05, 1e-4, "ModelExchange", 1e-12, excitation=1)
-    fmi3 = simulate3(box3_unzipdir, box3_md, 0.05, 1e-4, "ModelExchange", 1e-12, excitation=1)
+@pytest.mark.parametrize("ramp", [{}, {"rpm_rate": -150.0}], ids=["steady", "run-down"])
+def test_model_exchange_agrees_with_fmi2_within_the_tolerance(box_run, box3_unzipdir, box3_md, ramp):
+    """fmpy's CVode at rtol 1e-12, as the FMI 2.0 Model Exchange tests run it, at a steady
+    speed and on the run-down: xi within 1e-4 G_i and the same impact counts (FMI 3.0's state
+    vector holds the flywheel's two, the gears' xi, then their xi_dot)."""
+    fmi2 = box_run(0.05, 1e-4, "ModelExchange", 1e-12, excitation=1, **ramp)
+    fmi3 = simulate3(box3_unzipdir, box3_md, 0.05, 1e-4, "ModelExchange", 1e-12, excitation=1, **ramp)
     assert np.array_equal(fmi2["time"], fmi3["time"])
     start = {v.name: v.start for v in box3_md.modelVariables}
     G = np.array([float(g) for g in start["gear.G"].split()])
@@ -239,23 +240,29 @@ def test_three_gears_set_in_configuration_mode_run_as_fmi2s_three_to_the_bit(
     np.testing.assert_array_equal(rows, fmi2_rows)
 
 
-def test_three_gears_in_model_exchange_have_eight_states(box3_unzipdir, box3_md, vr3):
-    """FMI 3.0's state vector of three gears: phi, x_omega_I, the three xi, the three xi_dot,
-    as the variables read them."""
+def test_three_gears_in_model_exchange_have_ten_states(box3_unzipdir, box3_md, vr3):
+    """FMI 3.0's state vector of three gears: phi, x_omega_I, the flywheel's x_theta_F and
+    x_omega_F, the three xi, the three xi_dot, as the variables read them (the engine ramped,
+    so that every state is in use: x_omega_F at omega_F(0), its derivative alpha_F(0))."""
     from ctypes import c_double
 
     fmu = configured(box3_unzipdir, box3_md, FMU3Model, "three gears ME", 3, [])
     fmu.enterInitializationMode(startTime=0.0)
+    fmu.setFloat64([vr3["rpm_rate"]], [-150.0])
     fmu.exitInitializationMode()
-    assert fmu.getNumberOfContinuousStates() == 8
-    x = (c_double * 8)()
-    fmu.getContinuousStates(x, 8)
-    expected = fmu.getFloat64([vr3["phi"], vr3["x_omega_I"], vr3["gear.xi"], vr3["gear.xi_dot"]], nValues=8)
+    assert fmu.getNumberOfContinuousStates() == 10
+    x = (c_double * 10)()
+    fmu.getContinuousStates(x, 10)
+    expected = fmu.getFloat64([vr3["phi"], vr3["x_omega_I"], vr3["x_theta_F"], vr3["x_omega_F"], vr3["gear.xi"],
+                               vr3["gear.xi_dot"]], nValues=10)
     assert list(x) == expected
-    dx = (c_double * 8)()
-    fmu.getContinuousStateDerivatives(dx, 8)
-    assert list(dx) == fmu.getFloat64([vr3["der(phi)"], vr3["der(x_omega_I)"], vr3["der(gear.xi)"],
-                                       vr3["der(gear.xi_dot)"]], nValues=8)
+    assert x[3] == pytest.approx(800 * np.pi / 30) and x[3] == x[1]
+    dx = (c_double * 10)()
+    fmu.getContinuousStateDerivatives(dx, 10)
+    assert list(dx) == fmu.getFloat64([vr3["der(phi)"], vr3["der(x_omega_I)"], vr3["der(x_theta_F)"],
+                                       vr3["der(x_omega_F)"], vr3["der(gear.xi)"], vr3["der(gear.xi_dot)"]],
+                                      nValues=10)
+    assert dx[2] == x[3] and dx[3] == pytest.approx(-150 * np.pi / 30 + 600 + 120)
     fmu.terminate()
     fmu.freeInstance()
 

@@ -12,8 +12,8 @@
 //!     independent variable `time` and Model Exchange's event indicators (Float64 locals
 //!     `event_indicator_k`) are declared beside the contract's.
 //!   - ModelStructure: Output, ContinuousStateDerivative, InitialUnknown and EventIndicator
-//!     elements by value reference (an array's once: the states are phi, x_omega_I, then
-//!     every gear's xi, then every gear's xi_dot).
+//!     elements by value reference (an array's once: the states are phi, x_omega_I,
+//!     x_theta_F, x_omega_F, then every gear's xi, then every gear's xi_dot).
 //!   - Capabilities renamed where FMI 3.0 renamed them, dropped where it has none (and
 //!     canInterpolateInputs: FMI 3.0 has no fmi3SetInputDerivatives), and the adjoint
 //!     derivatives wherever the directional ones are offered (fmi3-shell computes them from
