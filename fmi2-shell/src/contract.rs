@@ -237,8 +237,14 @@ pub mod fmi3 {
 
         /// The offset of the element variable `vr` (any element), if it is one.
         pub fn element_offset(&self, vr: u32) -> Option<u32> {
+            self.element(vr).map(|(_, k)| k)
+        }
+
+        /// The element (1-based) and the offset of the element variable `vr`, if it is one.
+        pub fn element(&self, vr: u32) -> Option<(usize, u32)> {
             let k = vr.checked_sub(self.vr_base + self.vr_stride)?;
-            (k < self.vr_stride * self.size as u32).then_some(k % self.vr_stride)
+            (k < self.vr_stride * self.size as u32)
+                .then(|| ((k / self.vr_stride) as usize + 1, k % self.vr_stride))
         }
 
         /// The contract references of the first `n` elements of the array variable of

@@ -211,6 +211,7 @@ impl Slave for Instance {
         model_exchange: true,
         variable: contract::variable,
         variables: contract::VARIABLES,
+        arrays: contract::FMI3_ARRAYS,
     };
 
     fn new(logging_on: bool, interface: Interface) -> Self {

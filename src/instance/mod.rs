@@ -302,6 +302,7 @@ impl Slave for Instance {
         model_exchange: true,
         variable: contract::variable,
         variables: contract::VARIABLES,
+        arrays: contract::FMI3_ARRAYS,
     };
 
     fn interface(&self) -> Interface {
