@@ -188,6 +188,19 @@ pub fn check_parameter(v: &Variable, value: f64) -> FmiResult {
     )))
 }
 
+/// Whether any of `vrs` is a variable the model computes (an output or a local), looked up
+/// with `variable` (unknown references are not).
+pub fn computed(
+    variable: fn(Kind, u32) -> FmiResult<&'static Variable>,
+    kind: Kind,
+    vrs: &[u32],
+) -> bool {
+    vrs.iter().any(|vr| {
+        variable(kind, *vr)
+            .is_ok_and(|v| matches!(v.causality, Causality::Output | Causality::Local))
+    })
+}
+
 /// The error of a value reference the contract has no variable of that kind for.
 pub fn unknown(kind: Kind, vr: u32) -> FmiError {
     FmiError::error(format!("unknown value reference {vr} for type {kind:?}"))
