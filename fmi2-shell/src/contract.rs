@@ -188,6 +188,19 @@ pub fn check_parameter(v: &Variable, value: f64) -> FmiResult {
     )))
 }
 
+/// Whether any of `vrs` is a variable the model computes (an output or a local), looked up
+/// with `variable` (unknown references are not).
+pub fn computed(
+    variable: fn(Kind, u32) -> FmiResult<&'static Variable>,
+    kind: Kind,
+    vrs: &[u32],
+) -> bool {
+    vrs.iter().any(|vr| {
+        variable(kind, *vr)
+            .is_ok_and(|v| matches!(v.causality, Causality::Output | Causality::Local))
+    })
+}
+
 /// The error of a value reference the contract has no variable of that kind for.
 pub fn unknown(kind: Kind, vr: u32) -> FmiError {
     FmiError::error(format!("unknown value reference {vr} for type {kind:?}"))
@@ -237,8 +250,14 @@ pub mod fmi3 {
 
         /// The offset of the element variable `vr` (any element), if it is one.
         pub fn element_offset(&self, vr: u32) -> Option<u32> {
+            self.element(vr).map(|(_, k)| k)
+        }
+
+        /// The element (1-based) and the offset of the element variable `vr`, if it is one.
+        pub fn element(&self, vr: u32) -> Option<(usize, u32)> {
             let k = vr.checked_sub(self.vr_base + self.vr_stride)?;
-            (k < self.vr_stride * self.size as u32).then_some(k % self.vr_stride)
+            (k < self.vr_stride * self.size as u32)
+                .then(|| ((k / self.vr_stride) as usize + 1, k % self.vr_stride))
         }
 
         /// The contract references of the first `n` elements of the array variable of

@@ -332,6 +332,7 @@ mod tests {
             model_exchange: true,
             variable,
             variables: &VARIABLES,
+            arrays: &[],
         };
 
         fn new(_logging_on: bool, interface: Interface) -> Self {

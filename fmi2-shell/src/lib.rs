@@ -11,7 +11,9 @@
 //! - FMU states ([`fmu_state`]): boxed copies, and their serialized form with the model's
 //!   magic, version, GUID and a CRC;
 //! - statuses and errors in FMI's terms ([`status`]), and the store of the values set
-//!   ([`values`]);
+//!   ([`values`]) with the Integer getter the models share;
+//! - a co-simulation step with its errors, input extrapolation and logs ([`stepping`]), on
+//!   hooks the model supplies;
 //! - a packed FMU's start values, read from the model description beside the binary when
 //!   the importer's GUID is not the built-in one ([`packed`]);
 //! - the types of the contract and the checks of a variable's setting ([`contract`]) and, for
@@ -41,6 +43,7 @@ pub mod packed;
 pub mod slave;
 pub mod state;
 pub mod status;
+pub mod stepping;
 pub mod table;
 pub mod time;
 pub mod values;
@@ -53,4 +56,5 @@ pub use log::{Log, Message};
 pub use slave::{EventInfo, Identity, Interface, Slave};
 pub use state::FmiState;
 pub use status::{FmiError, FmiResult, Status};
+pub use stepping::Stepping;
 pub use vectors::Continuous;

@@ -6,13 +6,17 @@
 //! this binary's model identifier and the contract's variables (names, value references,
 //! types, causalities, in the contract's order); its parameters' start values then pass the
 //! checks of fmi2Set* and the contract's ranges and become the instance's start values.
+//! FMI 3.0 declares each variable of an array once (`gear.I_L`, docs/DECISIONS.md D46): its
+//! start lists elements 1..n, n the start of its structural parameter (`n_gears`, a UInt64),
+//! and each element's value is taken as that element's start value.
 
-use crate::contract::fmi3::{INTEGER_VR_OFFSET, TIME_VR};
-use crate::contract::{Causality, Kind, Variable, check_parameter};
+use crate::contract::fmi3::{Array, INTEGER_VR_OFFSET, TIME_VR};
+use crate::contract::{Causality, Kind, Start, Variable, check_parameter};
 use crate::slave::Identity;
 use crate::state::FmiState;
-use crate::status::FmiError;
+use crate::status::{FmiError, FmiResult};
 use crate::values::Starts;
+use std::borrow::Cow;
 use std::path::{Path, PathBuf};
 
 /// Why a model description beside the binary is not taken.
@@ -95,8 +99,61 @@ struct Declared<'a> {
     name: &'a str,
     vr: u32,
     kind: Kind,
+    /// Declared as FMI 3.0's UInt64 (a structural parameter).
+    size: bool,
     causality: &'a str,
     start: Option<&'a str>,
+}
+
+/// A contract variable as a model description declares it: in FMI 2.0 as it is; in FMI 3.0
+/// an array's variable once, as its element 1 renamed (`gear[1].I_L` is `gear.I_L`) at the
+/// array's reference, its other elements not at all, and an array's size as a structural
+/// parameter.
+struct Expected<'c> {
+    var: &'c Variable,
+    name: Cow<'c, str>,
+    vr: u32,
+    size: bool,
+    causality: &'static str,
+    /// The array and the offset of an FMI 3.0 array variable.
+    array: Option<(&'c Array, u32)>,
+}
+
+/// `v` as a model description (FMI 3.0 if `fmi3`) declares it, if it does.
+fn expected<'c>(v: &'c Variable, fmi3: bool, arrays: &'c [Array]) -> Option<Expected<'c>> {
+    let mut e = Expected {
+        var: v,
+        name: Cow::Borrowed(v.name),
+        vr: v.vr,
+        size: false,
+        causality: causality(v),
+        array: None,
+    };
+    if !fmi3 {
+        return Some(e);
+    }
+    if v.kind == Kind::Integer && arrays.iter().any(|a| a.size_vr == v.vr) {
+        e.size = true;
+        e.causality = "structuralParameter";
+    }
+    if let Some((a, (i, k))) = arrays.iter().find_map(|a| Some((a, a.element(v.vr)?))) {
+        if i > 1 {
+            return None;
+        }
+        e.name = Cow::Owned(v.name.replacen("[1].", ".", 1));
+        e.vr = a.vr_base + k;
+        e.array = Some((a, k));
+    }
+    Some(e)
+}
+
+/// The type a model description gives a variable, as a refusal names it.
+fn type_name(kind: Kind, size: bool) -> &'static str {
+    match (kind, size) {
+        (_, true) => "UInt64",
+        (Kind::Real, false) => "Real",
+        (Kind::Integer, false) => "Integer",
+    }
 }
 
 /// The start values of a model description (FMI 2.0 or 3.0) that names `token`, the model
@@ -135,31 +192,48 @@ pub fn read(id: &Identity, token: &str, xml: &str) -> Result<Starts, Refusal> {
         .into_iter()
         .filter(|d| !(fmi3 && d.vr >= TIME_VR))
         .collect();
-    if declared.len() != id.variables.len() {
+    let expected: Vec<_> = id
+        .variables
+        .iter()
+        .filter_map(|v| expected(v, fmi3, id.arrays))
+        .collect();
+    if declared.len() != expected.len() {
         return Err(mismatch(format!(
             "it declares {} variables of the contract's kinds, the contract {}",
             declared.len(),
-            id.variables.len()
+            expected.len()
         )));
     }
     let mut starts = Starts::default();
-    for (d, v) in declared.iter().zip(id.variables) {
-        if (d.name, d.vr, d.kind, d.causality) != (v.name, v.vr, v.kind, causality(v)) {
+    let mut lists = Vec::new();
+    for (d, e) in declared.iter().zip(&expected) {
+        let v = e.var;
+        if (d.name, d.vr, d.kind, d.size, d.causality)
+            != (&*e.name, e.vr, v.kind, e.size, e.causality)
+        {
             return Err(mismatch(format!(
-                "variable {} (value reference {}, {:?}, {}) is not the contract's {} ({}, {:?}, {})",
+                "variable {} (value reference {}, {}, {}) is not the contract's {} ({}, {}, {})",
                 d.name,
                 d.vr,
-                d.kind,
+                type_name(d.kind, d.size),
                 d.causality,
-                v.name,
-                v.vr,
-                v.kind,
-                causality(v)
+                e.name,
+                e.vr,
+                type_name(v.kind, e.size),
+                e.causality
             )));
         }
-        if let (Causality::Parameter, Some(start)) = (v.causality, d.start) {
-            start_value(v, start, &mut starts).map_err(Refusal::Invalid)?;
+        match (v.causality, d.start, e.array) {
+            (Causality::Parameter, Some(start), None) => {
+                start_value(v, start, &mut starts).map_err(Refusal::Invalid)?;
+            }
+            (Causality::Parameter, Some(list), Some((a, k))) => lists.push((e, a, k, list)),
+            _ => {}
         }
+    }
+    // The arrays' lengths are their structural parameters' starts, all read by now.
+    for (e, a, k, list) in lists {
+        array_start(id, e, a, k, list, &mut starts).map_err(Refusal::Invalid)?;
     }
     Ok(starts)
 }
@@ -173,9 +247,10 @@ fn declared<'a>(n: roxmltree::Node<'a, 'a>, fmi3: bool) -> Result<Declared<'a>, 
     } else {
         n.children().find(|c| c.is_element())
     };
-    let kind = match typed.map(|t| t.tag_name().name()) {
-        Some("Real" | "Float64") => Kind::Real,
-        Some("Integer" | "Int32" | "Enumeration") => Kind::Integer,
+    let (kind, size) = match typed.map(|t| t.tag_name().name()) {
+        Some("Real" | "Float64") => (Kind::Real, false),
+        Some("Integer" | "Int32" | "Enumeration") => (Kind::Integer, false),
+        Some("UInt64") if fmi3 => (Kind::Integer, true),
         other => return Err(format!("variable {name} has type {other:?}")),
     };
     let vr = n
@@ -192,9 +267,45 @@ fn declared<'a>(n: roxmltree::Node<'a, 'a>, fmi3: bool) -> Result<Declared<'a>, 
         name,
         vr,
         kind,
+        size,
         causality: n.attribute("causality").unwrap_or("local"),
         start: typed.and_then(|t| t.attribute("start")),
     })
+}
+
+/// An FMI 3.0 array parameter's start `list`: one value for each of the array's elements
+/// 1..n (n its structural parameter's start, the description's or else the contract's), each
+/// the start value of that element's variable ([`start_value`]), as fmi3SetFloat64 sets an
+/// array element by element.
+fn array_start(
+    id: &Identity,
+    e: &Expected,
+    a: &Array,
+    k: u32,
+    list: &str,
+    starts: &mut Starts,
+) -> FmiResult {
+    let size = (id.variable)(Kind::Integer, a.size_vr)?;
+    let n = match starts.integer.iter().find(|(vr, _)| *vr == a.size_vr) {
+        Some(&(_, n)) => i64::from(n),
+        None => match size.start {
+            Start::Integer(n) => n,
+            _ => 0,
+        },
+    };
+    let values: Vec<&str> = list.split_whitespace().collect();
+    if values.len() != n as usize {
+        return Err(FmiError::error(format!(
+            "parameter {}: {} start values for {} = {n}",
+            e.name,
+            values.len(),
+            size.name
+        )));
+    }
+    for (vr, text) in a.elements(k, values.len()).zip(values) {
+        start_value((id.variable)(e.var.kind, vr)?, text, starts)?;
+    }
+    Ok(())
 }
 
 /// A contract variable's causality as model descriptions write it.
@@ -275,22 +386,79 @@ mod tests {
         model_exchange: false,
         variable,
         variables: &VARIABLES,
+        arrays: &[],
     };
+
+    /// A model with an array `g` of two elements sized by `n` (1 <= n <= 2, start 2): g[i].m
+    /// at 10 + 10 i.
+    static GEARED: [Variable; 5] = [
+        var("k", 0, Kind::Real, Causality::Parameter),
+        Variable {
+            start: Start::Integer(2),
+            range: Range {
+                min: Bound::Inclusive(1.0),
+                max: Bound::Inclusive(2.0),
+            },
+            ..var("n", 0, Kind::Integer, Causality::Parameter)
+        },
+        var("g[1].m", 20, Kind::Real, Causality::Parameter),
+        var("g[2].m", 30, Kind::Real, Causality::Parameter),
+        var("y", 1, Kind::Real, Causality::Output),
+    ];
+
+    fn geared(kind: Kind, vr: u32) -> FmiResult<&'static Variable> {
+        GEARED
+            .iter()
+            .find(|v| (v.kind, v.vr) == (kind, vr))
+            .ok_or_else(|| unknown(kind, vr))
+    }
+
+    const GEARED_ID: Identity = Identity {
+        variable: geared,
+        variables: &GEARED,
+        arrays: &[Array {
+            size_vr: 0,
+            size: 2,
+            vr_base: 10,
+            vr_stride: 10,
+        }],
+        ..ID
+    };
+
+    /// An FMI 3.0 description packed under {packed}: the time, then `variables`.
+    fn fmi3_xml(variables: &str) -> String {
+        format!(
+            r#"<fmiModelDescription fmiVersion="3.0" instantiationToken="{{packed}}">
+  <CoSimulation modelIdentifier="Model"/>
+  <ModelVariables>
+    <Float64 name="time" valueReference="2000000" causality="independent"/>
+{variables}
+  </ModelVariables>
+</fmiModelDescription>"#
+        )
+    }
+
+    /// GEARED's FMI 3.0 description packed under {packed}: `n` the structural parameter's
+    /// attributes after its name, `m` the array's start list.
+    fn geared_xml(n: &str, m: &str) -> String {
+        fmi3_xml(&format!(
+            r#"    <Float64 name="k" valueReference="0" causality="parameter" start="1"/>
+    <UInt64 name="n" valueReference="1000000" {n}/>
+    <Float64 name="g.m" valueReference="10" causality="parameter" start="{m}">
+      <Dimension valueReference="1000000"/>
+    </Float64>
+    <Float64 name="y" valueReference="1" causality="output"/>"#
+        ))
+    }
 
     /// The model's description, FMI 2.0 or 3.0, packed under {packed} with k = `k`.
     fn xml(fmi3: bool, k: &str) -> String {
         if fmi3 {
-            format!(
-                r#"<fmiModelDescription fmiVersion="3.0" instantiationToken="{{packed}}">
-  <CoSimulation modelIdentifier="Model"/>
-  <ModelVariables>
-    <Float64 name="time" valueReference="2000000" causality="independent"/>
-    <Float64 name="k" valueReference="0" causality="parameter" start="{k}"/>
+            fmi3_xml(&format!(
+                r#"    <Float64 name="k" valueReference="0" causality="parameter" start="{k}"/>
     <Enumeration name="n" valueReference="1000000" causality="parameter" start="3"/>
-    <Float64 name="y" valueReference="1" causality="output"/>
-  </ModelVariables>
-</fmiModelDescription>"#
-            )
+    <Float64 name="y" valueReference="1" causality="output"/>"#
+            ))
         } else {
             format!(
                 r#"<fmiModelDescription fmiVersion="2.0" guid="{{packed}}">
@@ -391,6 +559,73 @@ mod tests {
         }
         let declared = ok.replace("</ModelVariables>", "<ScalarVariable name=\"z\" valueReference=\"2\"><Real/></ScalarVariable></ModelVariables>");
         assert!(refusal(read(&ID, "{packed}", &declared)).contains("declares 4 variables"));
+    }
+
+    #[test]
+    fn an_fmi3_array_gives_its_elements_start_values() {
+        let structural = |n: &str| format!("causality=\"structuralParameter\" start=\"{n}\"");
+        for (n, m, real, integer) in [
+            (
+                structural("2"),
+                "0.5 0.25",
+                vec![(20, 0.5), (30, 0.25)],
+                vec![(0, 2)],
+            ),
+            (structural("1"), "0.5", vec![(20, 0.5)], vec![(0, 1)]),
+            // Without a start of its own, n is the contract's.
+            (
+                "causality=\"structuralParameter\"".to_string(),
+                "0.5 0.25",
+                vec![(20, 0.5), (30, 0.25)],
+                vec![],
+            ),
+        ] {
+            let starts = read(&GEARED_ID, "{packed}", &geared_xml(&n, m)).unwrap();
+            assert_eq!(starts.real, [vec![(0, 1.0)], real].concat(), "{n} {m}");
+            assert_eq!(starts.integer, integer, "{n} {m}");
+        }
+    }
+
+    #[test]
+    fn an_fmi3_array_of_another_length_or_shape_is_refused() {
+        let structural = "causality=\"structuralParameter\" start=\"2\"";
+        for (text, why) in [
+            (
+                geared_xml(structural, "0.5"),
+                "invalid: parameter g.m: 1 start values for n = 2",
+            ),
+            (
+                geared_xml(
+                    "causality=\"structuralParameter\" start=\"3\"",
+                    "0.5 0.25 1",
+                ),
+                "invalid: parameter n = 3 is invalid: allowed 1 <= n <= 2",
+            ),
+            (
+                geared_xml(structural, "0.5 -1"),
+                "invalid: parameter g[2].m = -1e0 is invalid",
+            ),
+            (
+                geared_xml(structural, "0.5 soft"),
+                "invalid: parameter g[2].m: start value \"soft\"",
+            ),
+            (
+                geared_xml(structural, "0.5 0.25").replace("UInt64", "Int32"),
+                "mismatch: variable n (value reference 0, Integer, structuralParameter) is not the contract's n (0, UInt64, structuralParameter)",
+            ),
+            (
+                geared_xml("causality=\"parameter\" start=\"2\"", "0.5 0.25"),
+                "mismatch: variable n",
+            ),
+            // The elements declared one by one, as FMI 2.0 does.
+            (
+                geared_xml(structural, "0.5 0.25").replace("\"g.m\"", "\"g[1].m\""),
+                "mismatch: variable g[1].m",
+            ),
+        ] {
+            let refused = refusal(read(&GEARED_ID, "{packed}", &text));
+            assert!(refused.contains(why), "{refused}");
+        }
     }
 
     #[test]

@@ -3,6 +3,7 @@
 //! the state machine, unpack the arguments, apply FMI's rules ([`crate::fmu`]), call these
 //! methods, and turn their results into statuses and log lines.
 
+use crate::contract::fmi3::Array;
 use crate::contract::{Kind, Variable, no_variables};
 use crate::log::{Categories, Log};
 use crate::state::FmiState;
@@ -32,6 +33,9 @@ pub struct Identity {
     /// `contract::VARIABLES`): a packed model description is checked against it
     /// ([`crate::packed`]).
     pub variables: &'static [Variable],
+    /// The contract's arrays as FMI 3.0 declares them (the generated `FMI3_ARRAYS`): a packed
+    /// FMI 3.0 model description declares each of their variables once.
+    pub arrays: &'static [Array],
 }
 
 /// The interface an instance was instantiated for.

@@ -1,7 +1,7 @@
 //! The values of a model's parameters and inputs as last set, indexed by value reference,
 //! starting from the contract's start values.
 
-use crate::contract::{Kind, Start, Variable};
+use crate::contract::{Causality, Kind, Start, Variable};
 use crate::status::{FmiError, FmiResult};
 use serde::{Deserialize, Serialize};
 
@@ -71,6 +71,30 @@ impl Values {
     /// `vr` must be an Integer variable of the contract.
     pub fn integer(&self, vr: u32) -> i64 {
         self.integer[vr as usize]
+    }
+
+    /// fmi2GetInteger of a model whose Integer variables are parameters, kept here, and
+    /// outputs, which `output` computes (each of the contract's): every value saturated to
+    /// fmi2Integer's range. `variable` is the contract's look-up ([`Identity`]).
+    ///
+    /// [`Identity`]: crate::slave::Identity
+    pub fn get_integer(
+        &self,
+        variable: fn(Kind, u32) -> FmiResult<&'static Variable>,
+        vrs: &[u32],
+        out: &mut [i32],
+        output: impl Fn(u32) -> Option<i64>,
+    ) -> FmiResult {
+        for (vr, out) in vrs.iter().zip(out) {
+            let value = match variable(Kind::Integer, *vr)?.causality {
+                Causality::Output => {
+                    output(*vr).expect("every Integer output of the contract is computed")
+                }
+                _ => self.integer(*vr),
+            };
+            *out = i32::try_from(value).unwrap_or(i32::MAX);
+        }
+        Ok(())
     }
 
     /// Stores a value; `vr` must be a Real variable of the contract.

@@ -11,7 +11,9 @@ use crate::simulation::{self, Simulation};
 use fmi2_shell::values::Values;
 use fmi2_shell::{
     Continuous, EventInfo, FmiError, FmiResult, FmiState, Identity, Interface, Log, Slave, Status,
+    Stepping,
 };
+use gear_rattle::integrator::SolverError;
 
 /// The contract's log categories by role (errors and warnings first, as the shell wants).
 const EVENTS: usize = contract::log::logEvents;
@@ -57,11 +59,7 @@ impl Instance {
     /// Builds the simulation (as [`Self::current`]) when `vrs` asks for a computed variable, so
     /// that a getter computes its outputs from one readout ([`Now`]) for the whole call.
     fn build_if_computed(&mut self, kind: Kind, vrs: &[u32]) -> FmiResult {
-        let computed = |vr: &u32| {
-            contract::variable(kind, *vr)
-                .is_ok_and(|v| matches!(v.causality, Causality::Output | Causality::Local))
-        };
-        if vrs.iter().any(computed) {
+        if fmi2_shell::contract::computed(contract::variable, kind, vrs) {
             self.current()?;
         }
         Ok(())
@@ -99,9 +97,37 @@ impl Instance {
             sim.set_output_speed(omega_out);
         }
     }
+}
 
-    /// The drive's inputs follow their extrapolation when the master does not set them
-    /// again.
+/// The co-simulation step of fmi2-shell's [`Stepping`], on the running gearbox.
+impl Stepping for Instance {
+    /// The impacts per gear and the damper's stage.
+    type Events = ([[u64; 2]; 8], i32);
+    type StepError = SolverError;
+    const EVENTS: usize = EVENTS;
+    const STEPS: usize = STEPS;
+
+    fn events(&self) -> Self::Events {
+        let (gearbox, _) = self.sim.as_ref().expect("initialised").gearbox();
+        (
+            gearbox.gears.map(|g| g.impacts.count),
+            gearbox.regions().0.sign(),
+        )
+    }
+
+    /// The gearbox from `current` towards `t_end`, with `at_event` ended at the first
+    /// impact of any gear inside.
+    fn advance(&mut self, current: f64, t_end: f64, at_event: bool) -> Result<f64, SolverError> {
+        let sim = self.sim_mut();
+        sim.t = current;
+        sim.step_until(t_end, at_event)
+    }
+
+    fn is_finite(&self) -> bool {
+        let (_, y) = self.sim.as_ref().expect("initialised").gearbox();
+        y.iter().all(|v| v.is_finite())
+    }
+
     fn sync_inputs(&mut self) {
         let Some((flywheel, shaft)) = self.sim.as_ref().and_then(Simulation::extrapolated_inputs)
         else {
@@ -117,7 +143,7 @@ impl Instance {
     }
 
     /// logEvents after a step: the impacts it counted per gear and the damper's stage.
-    fn log_events(&mut self, t_end: f64, before: ([[u64; 2]; 8], i32)) {
+    fn log_events(&mut self, t_end: f64, before: Self::Events) {
         let (gearbox, _) = self.sim.as_ref().expect("initialised").gearbox();
         let (stage, _) = gearbox.regions();
         let lines: Vec<String> = (0..gearbox.n_gears())
@@ -145,48 +171,6 @@ impl Instance {
         }
     }
 
-    /// The impacts per gear and the damper's stage, what the event log compares with.
-    fn events(sim: &Simulation) -> ([[u64; 2]; 8], i32) {
-        let (gearbox, _) = sim.gearbox();
-        (
-            gearbox.gears.map(|g| g.impacts.count),
-            gearbox.regions().0.sign(),
-        )
-    }
-
-    /// A communication step from the master's point `current` (the shell has checked it)
-    /// towards current + h, with `at_impact` ended at the first impact of any gear inside
-    /// it; returns the time reached. A failure leaves the state at `current`.
-    fn step_until(&mut self, current: f64, h: f64, at_impact: bool) -> FmiResult<f64> {
-        let t_end = current + h;
-        let sim = self.sim_mut();
-        sim.t = current;
-        let before = self
-            .log
-            .is_on(EVENTS)
-            .then(|| Self::events(self.sim.as_ref().unwrap()));
-        let sim = self.sim_mut();
-        let finite = |sim: &Simulation| sim.gearbox().1.iter().all(|v| v.is_finite());
-        match sim.step_until(t_end, at_impact) {
-            Ok(_) if !finite(sim) => Err(FmiError::error(format!(
-                "fmi2DoStep from t = {current} to {t_end} failed: the state is no longer finite (times, steps or inputs beyond what the model can represent); fmi2Reset to start over"
-            ))),
-            Ok(reached) => {
-                self.sync_inputs();
-                if let Some(before) = before {
-                    self.log_events(reached, before);
-                }
-                if self.log.is_on(STEPS) {
-                    self.log_steps(reached);
-                }
-                Ok(reached)
-            }
-            Err(e) => Err(FmiError::error(format!(
-                "fmi2DoStep from t = {current} to {t_end} failed: {e}; the state stays at t = {current}"
-            ))),
-        }
-    }
-
     /// logStep after a step: the solver's work so far.
     fn log_steps(&mut self, t_end: f64) {
         let sim = self.sim.as_ref().expect("initialised");
@@ -211,6 +195,7 @@ impl Slave for Instance {
         model_exchange: true,
         variable: contract::variable,
         variables: contract::VARIABLES,
+        arrays: contract::FMI3_ARRAYS,
     };
 
     fn new(logging_on: bool, interface: Interface) -> Self {
@@ -275,18 +260,9 @@ impl Slave for Instance {
     fn get_integer(&mut self, vrs: &[u32], out: &mut [i32]) -> FmiResult {
         self.build_if_computed(Kind::Integer, vrs)?;
         let now = self.sim.as_ref().map(Now::new);
-        for (vr, out) in vrs.iter().zip(out) {
-            let var = contract::variable(Kind::Integer, *vr)?;
-            let value = match var.causality {
-                Causality::Output => now
-                    .as_ref()
-                    .and_then(|now| now.integer(*vr))
-                    .expect("every Integer output of the contract is computed"),
-                _ => self.values.integer(*vr),
-            };
-            *out = i32::try_from(value).unwrap_or(i32::MAX);
-        }
-        Ok(())
+        let output = |vr| now.as_ref()?.integer(vr);
+        self.values
+            .get_integer(contract::variable, vrs, out, output)
     }
 
     /// Sets parameters or inputs (the shell has checked the whole call).
@@ -337,9 +313,8 @@ impl Slave for Instance {
     }
 
     fn new_discrete_states(&mut self) -> FmiResult<EventInfo> {
-        let sim = self.sim.as_ref().expect("initialised");
-        let t = sim.t;
-        let before = Self::events(sim);
+        let t = self.sim.as_ref().expect("initialised").t;
+        let before = self.events();
         let next_event_time = self.sim_mut().update_discrete_states();
         if self.log.is_on(EVENTS) {
             self.log_events(t, before);

@@ -11,10 +11,11 @@ pub use fmi2_shell::{FmiError, FmiResult, FmiState, Status};
 pub use simulation::{Carry, Simulation};
 
 use crate::contract::{self, Causality, Kind, LOG_CATEGORIES, vr};
+use crate::integrator::SolverError;
 use crate::physics::Shaft;
 use crate::rattle::Impacts;
 use fmi2_shell::values::Values;
-use fmi2_shell::{Continuous, EventInfo, Identity, Interface, Log, Slave};
+use fmi2_shell::{Continuous, EventInfo, Identity, Interface, Log, Slave, Stepping};
 
 use serde::{Deserialize, Serialize};
 
@@ -147,20 +148,6 @@ impl Instance {
         self.sim.as_mut().expect("initialised")
     }
 
-    /// Main inputs coherent with the previous values: `theta_M` and `omega_M` (inputs mode)
-    /// or `tau_in` (torque mode) follow the extrapolation when the master does not set them
-    /// again (see `Simulation::step_to`).
-    fn sync_inputs(&mut self) {
-        match self.sim.as_ref().map(|sim| sim.drive) {
-            Some(simulation::Drive::Inputs(shaft)) => {
-                self.values.set_real(vr::theta_M, shaft.theta);
-                self.values.set_real(vr::omega_M, shaft.omega);
-            }
-            Some(simulation::Drive::Torque { tau, .. }) => self.values.set_real(vr::tau_in, tau),
-            _ => {}
-        }
-    }
-
     fn simulation(&self) -> &Simulation {
         self.sim.as_ref().expect("initialised")
     }
@@ -172,46 +159,50 @@ impl Instance {
             "DOPRI5"
         }
     }
+}
 
-    /// A communication step from the master's point `current` (the shell has checked it)
-    /// towards current + h, with `at_impact` ended at the first impact inside it; returns
-    /// the time reached. A failure leaves the state at `current`.
-    fn step_until(&mut self, current: f64, h: f64, at_impact: bool) -> FmiResult<f64> {
+/// The co-simulation step of fmi2-shell's [`Stepping`], on the running gear pair.
+impl Stepping for Instance {
+    /// The impacts and the hand-overs of the method.
+    type Events = (Impacts, u64);
+    type StepError = SolverError;
+    const EVENTS: usize = EVENTS;
+    const STEPS: usize = STEPS;
+
+    fn events(&self) -> Self::Events {
+        let sim = self.simulation();
+        (sim.impacts(), sim.stats().switches)
+    }
+
+    /// The gear pair from `current` towards `t_end`, with `at_event` ended at the first
+    /// impact inside.
+    fn advance(&mut self, current: f64, t_end: f64, at_event: bool) -> Result<f64, SolverError> {
         let sim = self.sim.as_mut().expect("initialised");
         sim.t = current;
-        let t_end = current + h;
-        // What the event log compares with, taken only when that log is on.
-        let before = self
-            .log
-            .is_on(EVENTS)
-            .then(|| (sim.impacts(), sim.stats().switches));
-        // A state that overflowed (far out on the time axis, huge inputs) is a failed step.
-        let overflowed = |sim: &Simulation| {
-            let (xi, xi_dot) = (sim.real_output(vr::xi), sim.real_output(vr::xi_dot));
-            !(xi.is_some_and(f64::is_finite) && xi_dot.is_some_and(f64::is_finite))
-        };
-        match sim.step_until(t_end, at_impact) {
-            Ok(_) if overflowed(sim) => Err(FmiError::error(format!(
-                "fmi2DoStep from t = {current} to {t_end} failed: the state is no longer finite (times, steps or inputs beyond what the model can represent); fmi2Reset to start over"
-            ))),
-            Ok(reached) => {
-                self.sync_inputs();
-                if let Some(before) = before {
-                    self.log_events(reached, before);
-                }
-                if self.log.is_on(STEPS) {
-                    self.log_steps(reached);
-                }
-                Ok(reached)
+        sim.step_until(t_end, at_event)
+    }
+
+    fn is_finite(&self) -> bool {
+        let sim = self.simulation();
+        let (xi, xi_dot) = (sim.real_output(vr::xi), sim.real_output(vr::xi_dot));
+        xi.is_some_and(f64::is_finite) && xi_dot.is_some_and(f64::is_finite)
+    }
+
+    /// `theta_M` and `omega_M` (inputs mode) or `tau_in` (torque mode) follow the
+    /// extrapolation (see `Simulation::step_to`).
+    fn sync_inputs(&mut self) {
+        match self.sim.as_ref().map(|sim| sim.drive) {
+            Some(simulation::Drive::Inputs(shaft)) => {
+                self.values.set_real(vr::theta_M, shaft.theta);
+                self.values.set_real(vr::omega_M, shaft.omega);
             }
-            Err(e) => Err(FmiError::error(format!(
-                "fmi2DoStep from t = {current} to {t_end} failed: {e}; the state stays at t = {current}"
-            ))),
+            Some(simulation::Drive::Torque { tau, .. }) => self.values.set_real(vr::tau_in, tau),
+            _ => {}
         }
     }
 
     /// logEvents after a step: the impacts it counted and a hand-over of the method.
-    fn log_events(&mut self, t_end: f64, (impacts_before, switches_before): (Impacts, u64)) {
+    fn log_events(&mut self, t_end: f64, (impacts_before, switches_before): Self::Events) {
         let sim = self.simulation();
         let (impacts, switched) = (sim.impacts(), sim.stats().switches != switches_before);
         let method = Self::method_name(sim);
@@ -302,6 +293,7 @@ impl Slave for Instance {
         model_exchange: true,
         variable: contract::variable,
         variables: contract::VARIABLES,
+        arrays: contract::FMI3_ARRAYS,
     };
 
     fn interface(&self) -> Interface {
@@ -378,18 +370,13 @@ impl Slave for Instance {
     }
 
     fn get_integer(&mut self, vrs: &[u32], out: &mut [i32]) -> FmiResult {
-        for (vr, out) in vrs.iter().zip(out) {
-            let var = contract::variable(Kind::Integer, *vr)?;
-            let value = match var.causality {
-                Causality::Output => self
-                    .current()?
-                    .integer_output(*vr)
-                    .expect("every Integer output of the contract is computed"),
-                _ => self.values.integer(*vr),
-            };
-            *out = i32::try_from(value).unwrap_or(i32::MAX);
+        if fmi2_shell::contract::computed(contract::variable, Kind::Integer, vrs) {
+            self.current()?;
         }
-        Ok(())
+        let sim = self.sim.as_ref();
+        let output = |vr| sim?.integer_output(vr);
+        self.values
+            .get_integer(contract::variable, vrs, out, output)
     }
 
     /// Sets Real parameters or inputs (the shell has checked the whole call).

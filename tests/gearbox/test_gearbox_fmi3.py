@@ -15,12 +15,7 @@ from gearrattle import fmpy_run
 from gearrattle import gearbox_fmu as GF
 from support.early_return import step_to_impacts
 from support.fmu import session_fixtures
-
-GEARBOX_FMU3_PATH = GF.ROOT / "target" / "fmu" / "fmi3" / "GearboxRattle.fmu"
-BUILD_GEARBOX_FMU3 = (
-    "`make fmu` (or `cargo build --release -p gearbox_rattle_fmu && cargo run --profile quick -p packaging -- "
-    "--model GearboxRattle --fmi 3 --lib target/release/libgearbox_rattle_fmu.so --out target/fmu/fmi3/GearboxRattle.fmu`)"
-)
+from support.gearbox import BUILD_GEARBOX_FMU3, GEARBOX_FMU3_PATH
 
 
 box3_path, box3_md, box3_unzipdir, vr3 = session_fixtures(

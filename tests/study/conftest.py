@@ -24,3 +24,10 @@ def gearbox_fmu():
     from support.gearbox import BUILD_GEARBOX_FMU, GEARBOX_FMU_PATH
 
     return require(GEARBOX_FMU_PATH, BUILD_GEARBOX_FMU)
+
+
+@pytest.fixture(scope="session")
+def gearbox_fmu3():
+    from support.gearbox import BUILD_GEARBOX_FMU3, GEARBOX_FMU3_PATH
+
+    return require(GEARBOX_FMU3_PATH, BUILD_GEARBOX_FMU3)

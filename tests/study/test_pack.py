@@ -1,14 +1,16 @@
 """The binary of a packed FMU starts from the model description it ships with (fmi2-shell's
-packed.rs): FMI 3.0 as FMI 2.0; a description that is not its model's, or a GUID it does not
-name, is refused with the GUID expected; an invalid start value is refused naming the parameter
-and its range."""
+packed.rs): FMI 3.0 as FMI 2.0, the FMI 3.0 gearbox's arrays as the FMI 2.0 gearbox's gears; a
+description that is not its model's, or a GUID it does not name, is refused with the GUID
+expected; an invalid start value is refused naming the parameter and its range."""
 
 import zipfile
 
 import numpy as np
 import pytest
 
+from gearrattle import gearbox_fmu as GF
 from gearrattle.study import pack as P
+from gearrattle.study.errors import StudyError
 from gearrattle.study.model import read_model
 from support.fmu import FMU3_PATH
 
@@ -57,6 +59,73 @@ def test_fmi3_packed_runs_its_start_values(tmp_path):
     default = simulate_fmu(str(FMU3_PATH), **kw)
     assert np.array_equal(packed["xi"], told["xi"])
     assert not np.array_equal(packed["xi"], default["xi"])
+
+
+# Four gears (the FMU's default is five): gear 1 given a backlash, gear 2 an inertia, gear 4
+# nothing of its own.
+BOX4 = """
+[box]
+k_1 = 22.0
+[[gear]]
+G = 110e-6
+[[gear]]
+I_L = 0.5e-3
+[[gear]]
+C_LM = 45.0
+[[gear]]
+"""
+
+
+def _box(tmp_path, text):
+    path = tmp_path / "box.toml"
+    path.write_text(text)
+    return str(path)
+
+
+def test_fmi3_gearbox_packs_as_the_fmi2_gearbox(gearbox_fmu, gearbox_fmu3, tmp_path):
+    """The FMI 3.0 gearbox packed with a box of four gears: n_gears 4, each per-gear array's
+    start list the FMI 2.0 packed description's four gears', and co-simulation with no start
+    values equal to the FMI 2.0 gearbox packed with the same box, to the bit."""
+    from fmpy import read_model_description, simulate_fmu
+    from fmpy.validation import validate_fmu
+
+    box = _box(tmp_path, BOX4)
+    out2, out3 = str(tmp_path / "box2.fmu"), str(tmp_path / "box3.fmu")
+    P.pack(box, gearbox_fmu, out2)
+    P.pack(box, gearbox_fmu3, out3)
+    assert validate_fmu(out3) == []
+    fmi2 = {v.name: v for v in read_model_description(out2).modelVariables}
+    fmi3 = {v.name: v for v in read_model_description(out3).modelVariables}
+    assert fmi3["n_gears"].start == fmi2["n_gears"].start == "4"
+    arrays = [n for n, v in fmi3.items() if v.dimensions and v.start is not None]
+    assert len(arrays) == 13
+    for name in arrays:
+        each = [float(fmi2[name.replace("gear.", f"gear[{i}].")].start) for i in range(1, 5)]
+        assert [float(x) for x in fmi3[name].start.split()] == each, name
+    assert fmi3["gear.G"].start.split()[0] == repr(110e-6)
+    kw = dict(stop_time=0.1, output_interval=1e-3)
+    run2 = simulate_fmu(out2, output=GF.outputs(4), **kw)
+    run3 = simulate_fmu(out3, output=list(GF.BOX_OUTPUTS) + [f"gear.{f}" for f in GF.GEAR_OUTPUTS],
+                        **kw)
+    for name in GF.BOX_OUTPUTS:
+        assert np.array_equal(run3[name], run2[name]), name
+    for field in GF.GEAR_OUTPUTS:
+        each = np.array([run2[f"gear[{i}].{field}"] for i in range(1, 5)]).T
+        assert np.array_equal(run3[f"gear.{field}"], each), field
+    default = simulate_fmu(gearbox_fmu3, output=["gear.xi"], **kw)
+    assert default["gear.xi"].shape[1] == 5
+    assert not np.array_equal(default["gear.xi"][:, 0], run3["gear.xi"][:, 0])
+
+
+def test_fmi3_gearbox_needs_the_extra_gears_values(gearbox_fmu3, tmp_path):
+    """The FMI 3.0 description gives the starts of its five default gears only: a sixth gear
+    needs all its values from the box, and is refused naming the first one missing."""
+    six = _box(tmp_path, BOX4 + "[[gear]]\n[[gear]]\nG = 1e-4\n")
+    with pytest.raises(StudyError) as e:
+        P.pack(six, gearbox_fmu3, str(tmp_path / "six.fmu"))
+    said = str(e.value)
+    assert "gear[6].I_L has no start value" in said and "give it in the box" in said, said
+    assert not (tmp_path / "six.fmu").exists()
 
 
 def test_a_tampered_description_is_refused(gearbox_fmu, tmp_path):

@@ -18,6 +18,11 @@ BUILD_GEARBOX_FMU = (
     "`make fmu` (or `cargo build --release -p gearbox_rattle_fmu && cargo run --profile quick "
     "-p packaging -- --model GearboxRattle --lib target/release/libgearbox_rattle_fmu.so --out target/fmu/GearboxRattle.fmu`)"
 )
+GEARBOX_FMU3_PATH = GF.ROOT / "target" / "fmu" / "fmi3" / "GearboxRattle.fmu"
+BUILD_GEARBOX_FMU3 = (
+    "`make fmu` (or `cargo build --release -p gearbox_rattle_fmu && cargo run --profile quick -p packaging -- "
+    "--model GearboxRattle --fmi 3 --lib target/release/libgearbox_rattle_fmu.so --out target/fmu/fmi3/GearboxRattle.fmu`)"
+)
 # Each scene's pointwise-predictable window [s] (the reference's own perturbed runs: a 1e-10 G
 # difference grows to 1e-4 G past it) and the rate spread of its perturbed runs beyond.
 WINDOW = {"B1": 0.35, "R1": 0.40, "B2": 2.0}

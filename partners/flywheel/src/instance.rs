@@ -60,6 +60,7 @@ impl Slave for Instance {
         model_exchange: false,
         variable: contract::variable,
         variables: contract::VARIABLES,
+        arrays: contract::FMI3_ARRAYS,
     };
 
     fn new(logging_on: bool, _interface: Interface) -> Self {

@@ -4,11 +4,17 @@ range) and the metrics, i.e. every output whose name, or last component of a str
 
 A parameter's range is the statement its description ends with, "(range: I_L > 0)", as the
 contract's generator writes it (exclusive bounds included, which FMI 2.0's min and max cannot
-express), or else its min and max."""
+express), or else its min and max.
+
+FMI 3.0's types are taken as FMI 2.0's (Float64 a Real, Int32, UInt64 and Enumeration
+Integers); its structural parameters (GearboxRattle's `n_gears`) are parameters, and an array
+parameter (`gear.I_L`, sized by `n_gears`) stands as its elements under FMI 2.0's names
+(`gear[1].I_L` .. `gear[8].I_L`, up to its structural parameter's largest value), each with
+the range of the array and the start its start list gives it (none past the list's end)."""
 
 import math
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 METRIC_PREFIX = "stat_"
 STATS_FROM = "stats_from"
@@ -18,7 +24,7 @@ STATS_FROM = "stats_from"
 class Var:
     name: str
     vr: int
-    type: str  # "Real", "Integer" or "Boolean"
+    type: str  # "Real", "Integer" or "Boolean" (FMI 3.0's types as these)
     start: float | None
     min: float | None
     max: float | None
@@ -55,6 +61,9 @@ class Model:
     parameters: dict  # name -> Var, in the order of the model description
     outputs: dict  # name -> Var
     metrics: tuple  # the stat_* outputs (Var), in the order of the model description
+    # FMI 3.0: each array parameter's name -> (its structural parameter's name, the names of
+    # its elements in `parameters`)
+    arrays: dict = field(default_factory=dict)
 
     @property
     def has_stats_from(self):
@@ -64,6 +73,19 @@ class Model:
 def is_metric(name):
     """A `stat_*` output, of the model or of one of its parts (`gear[2].stat_regime`)."""
     return name.rsplit(".", 1)[-1].startswith(METRIC_PREFIX)
+
+
+# FMI 3.0's types by FMI 2.0's name.
+_FMI2_TYPE = {"Float64": "Real", "Float32": "Real", "Enumeration": "Integer"}
+# Parameters: FMI 3.0's structural parameters besides FMI 2.0's.
+_PARAMETER = ("parameter", "structuralParameter")
+
+
+def _type(fmi_type):
+    """"Real", "Integer" or "Boolean" for a type of FMI 2.0 or 3.0."""
+    if fmi_type.startswith(("Int", "UInt")):
+        return "Integer"
+    return _FMI2_TYPE.get(fmi_type, fmi_type)
 
 
 def _number(text, kind):
@@ -92,20 +114,43 @@ def _range(name, description, xml_min, xml_max):
     return xml_min, False, xml_max, False
 
 
+def _var(v, name=None, start=None):
+    """The study's Var of fmpy's model variable v (as `name`, with `start`, for an element of
+    an array: the array's range stated under its own name)."""
+    kind = _type(v.type)
+    lo, lo_open, hi, hi_open = _range(v.name, v.description, _number(v.min, kind),
+                                      _number(v.max, kind))
+    return Var(name or v.name, v.valueReference, kind,
+               start if name else _number(v.start, kind), lo, hi, v.unit, lo_open, hi_open,
+               v.description or "")
+
+
+def _elements(v, size):
+    """An FMI 3.0 array parameter `ARRAY.NAME` as its elements `ARRAY[i].NAME`, i = 1 .. the
+    largest value of its structural parameter (the Var `size`)."""
+    starts = [_number(t, _type(v.type)) for t in (v.start or "").split()]
+    array, _, name = v.name.partition(".")
+    count = int(size.max) if size.max is not None else len(starts)
+    return [_var(v, f"{array}[{i}].{name}", starts[i - 1] if i <= len(starts) else None)
+            for i in range(1, count + 1)]
+
+
 def read_model(fmu):
     """The study's view of an FMU (a .fmu file or an extracted directory)."""
     from fmpy import read_model_description
 
     md = read_model_description(fmu)
-    params, outs = {}, {}
+    params, outs, arrays = {}, {}, {}
     for v in md.modelVariables:
-        lo, lo_open, hi, hi_open = _range(v.name, v.description, _number(v.min, v.type),
-                                          _number(v.max, v.type))
-        var = Var(v.name, v.valueReference, v.type, _number(v.start, v.type), lo, hi, v.unit,
-                  lo_open, hi_open, v.description or "")
-        if v.causality == "parameter" and v.variability in ("fixed", "tunable"):
-            params[v.name] = var
+        if v.causality in _PARAMETER and v.variability in ("fixed", "tunable"):
+            if getattr(v, "dimensions", None):
+                size = params[v.dimensions[0].variable.name]
+                elements = _elements(v, size)
+                params.update((e.name, e) for e in elements)
+                arrays[v.name] = (size.name, [e.name for e in elements])
+            else:
+                params[v.name] = _var(v)
         elif v.causality == "output":
-            outs[v.name] = var
+            outs[v.name] = _var(v)
     metrics = tuple(v for n, v in outs.items() if is_metric(n))
-    return Model(md.guid, md.coSimulation.modelIdentifier, params, outs, metrics)
+    return Model(md.guid, md.coSimulation.modelIdentifier, params, outs, metrics, arrays)

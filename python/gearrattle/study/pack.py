@@ -11,7 +11,12 @@ the original's and the box's values, so the same box packed from the same FMU ha
 GUID and two boxes differ. The binary, given a GUID other than its built-in one, reads the
 model description it ships with and takes its start values if that description names the GUID
 and the binary's variables (fmi2-shell's packed.rs): an importer that sets no parameter runs
-the packed box, and fmi2Reset returns to it."""
+the packed box, and fmi2Reset returns to it.
+
+FMI 3.0's GearboxRattle declares each per-gear parameter once, as an array sized by `n_gears`
+(docs/DECISIONS.md D46): its start list gets n_gears values, the box's at its gears and the
+FMU's elsewhere. That description lists the starts of its default gears only (1..5), so a box
+of more gears gives each of the extra gears all its values (or packs the FMI 2.0 FMU)."""
 
 import re
 import uuid
@@ -27,7 +32,7 @@ RESOURCE_XML = "resources/" + XML
 
 
 def _start_text(var, value):
-    return repr(float(value)) if var.type in ("Real", "Float64") else str(int(value))
+    return repr(float(value)) if var.type == "Real" else str(int(value))
 
 
 def packed_guid(guid, values):
@@ -37,19 +42,62 @@ def packed_guid(guid, values):
     return "{" + str(uuid.uuid5(uuid.NAMESPACE_OID, text)) + "}"
 
 
+def _start(name):
+    """The pattern of the start attribute of the variable `name` (FMI 2.0 or 3.0): the text
+    before its value, the value, the closing quote."""
+    n = re.escape(name)
+    return re.compile(r'((?:<ScalarVariable name="' + n + r'"[^>]*>\s*<(?:Real|Integer|'
+                      r'Enumeration)\b|<(?:Float64|Int32|UInt64|Enumeration) name="' + n
+                      + r'")[^>]*?\bstart=")([^"]*)(")')
+
+
+def _replace_start(xml, name, where, text):
+    """xml with the start of `name` replaced by text(its current start)."""
+    xml, count = _start(name).subn(lambda m: m[1] + text(m[2]) + m[3], xml, count=1)
+    if count != 1:
+        raise StudyError(f"{where}: {name} has no start value in {XML} to replace")
+    return xml
+
+
+def _array_start(values, model, array, old):
+    """The start list of the FMI 3.0 array parameter `array` (its start `old`, text) for
+    values: one value per element up to its structural parameter's value (the box's, else
+    the FMU's), each the box's or else the FMU's start (its text kept)."""
+    size, elements = model.arrays[array]
+    n, n_where = values.get(size, (model.parameters[size].start, XML))
+    n = int(n)
+    for name in elements[n:]:
+        if name in values:
+            raise StudyError(f"{values[name][1]}: {name} is past {size} = {n} ({n_where}): an "
+                             f"FMI 3.0 array holds elements 1..{size} only")
+    listed = old.split()
+    starts = []
+    for i, name in enumerate(elements[:n]):
+        if name in values:
+            starts.append(_start_text(model.parameters[name], values[name][0]))
+        elif i < len(listed):
+            starts.append(listed[i])
+        else:
+            raise StudyError(f"{n_where}: {name} has no start value in the FMI 3.0 {XML} "
+                             f"(which gives elements 1..{len(listed)} of {array}): give it in "
+                             f"the box, or pack the FMI 2.0 FMU, whose description has one")
+    return " ".join(starts)
+
+
 def rewrite(xml, values, model):
     """The model description (FMI 2.0 or 3.0) with the start values replaced and the packed
     GUID (text, not a re-serialized tree: attribute order, comments and spacing stay as the
-    generator wrote them)."""
+    generator wrote them). FMI 3.0's array parameters get start lists as long as their
+    structural parameter says, where that or one of their elements changes."""
+    elements = {e: a for a, (_, names) in model.arrays.items() for e in names}
     for name, (value, where) in values.items():
-        n = re.escape(name)
-        pattern = re.compile(r'((?:<ScalarVariable name="' + n + r'"[^>]*>\s*<(?:Real|Integer|'
-                             r'Enumeration)\b|<(?:Float64|Int32|Enumeration) name="' + n
-                             + r'")[^>]*?\bstart=")[^"]*(")')
-        xml, count = pattern.subn(lambda m: m[1] + _start_text(model.parameters[name], value)
-                                  + m[2], xml, count=1)
-        if count != 1:
-            raise StudyError(f"{where}: {name} has no start value in {XML} to replace")
+        if name not in elements:
+            xml = _replace_start(xml, name, where,
+                                 lambda _: _start_text(model.parameters[name], value))
+    for array, (size, names) in model.arrays.items():
+        if size in values or any(n in values for n in names):
+            xml = _replace_start(xml, array, XML,
+                                 lambda old: _array_start(values, model, array, old))
     guid = re.compile(r'(<fmiModelDescription\b[^>]*?\b(?:guid|instantiationToken)=")[^"]*(")')
     return guid.sub(lambda m: m[1] + packed_guid(model.guid, values) + m[2], xml, count=1)
 

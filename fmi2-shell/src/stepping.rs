@@ -1,0 +1,69 @@
+//! A co-simulation step as the models of this shell take it, written once: the model steps
+//! its running simulation from the master's point; a step that fails, or ends in a state
+//! that is no longer finite, becomes the error the importer reads; one that succeeds brings
+//! the inputs the master does not set again in line with their extrapolation and writes the
+//! event and step logs. The model supplies the hooks.
+
+use crate::slave::Slave;
+use crate::status::{FmiError, FmiResult};
+use std::fmt::Display;
+
+/// What a model supplies to [`Stepping::step_until`], the step of its [`Slave::step`] and
+/// [`Slave::step_to_event`].
+pub trait Stepping: Slave {
+    /// What logEvents compares the end of a step with: the model's event counts before it.
+    type Events;
+    /// Why the simulation refused a step.
+    type StepError: Display;
+    /// The contract's log categories of events and of the solver's steps.
+    const EVENTS: usize;
+    const STEPS: usize;
+
+    /// The event counts now (the simulation is running).
+    fn events(&self) -> Self::Events;
+
+    /// Steps the running simulation from `current` towards `t_end`, with `at_event` ended at
+    /// its first event inside; returns the time reached. A failure leaves it at `current`.
+    fn advance(&mut self, current: f64, t_end: f64, at_event: bool)
+    -> Result<f64, Self::StepError>;
+
+    /// Whether the simulation's state is finite.
+    fn is_finite(&self) -> bool;
+
+    /// The inputs follow their extrapolation where the master does not set them again.
+    fn sync_inputs(&mut self);
+
+    /// logEvents after a step ended at `t`: what happened since `before`.
+    fn log_events(&mut self, t: f64, before: Self::Events);
+
+    /// logStep after a step ended at `t`: the solver's work so far.
+    fn log_steps(&mut self, t: f64);
+
+    /// A communication step from the master's point `current` (the shell has checked it)
+    /// towards current + h, with `at_event` ended at the first event inside it; returns the
+    /// time reached. A failure leaves the state at `current`.
+    fn step_until(&mut self, current: f64, h: f64, at_event: bool) -> FmiResult<f64> {
+        let t_end = current + h;
+        // What the event log compares with, taken only when that log is on.
+        let before = self.log().is_on(Self::EVENTS).then(|| self.events());
+        match self.advance(current, t_end, at_event) {
+            // A state that overflowed (far out on the time axis, huge inputs) is a failed step.
+            Ok(_) if !self.is_finite() => Err(FmiError::error(format!(
+                "fmi2DoStep from t = {current} to {t_end} failed: the state is no longer finite (times, steps or inputs beyond what the model can represent); fmi2Reset to start over"
+            ))),
+            Ok(reached) => {
+                self.sync_inputs();
+                if let Some(before) = before {
+                    self.log_events(reached, before);
+                }
+                if self.log().is_on(Self::STEPS) {
+                    self.log_steps(reached);
+                }
+                Ok(reached)
+            }
+            Err(e) => Err(FmiError::error(format!(
+                "fmi2DoStep from t = {current} to {t_end} failed: {e}; the state stays at t = {current}"
+            ))),
+        }
+    }
+}
