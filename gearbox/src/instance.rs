@@ -155,10 +155,9 @@ impl Instance {
     }
 
     /// A communication step from the master's point `current` (the shell has checked it)
-    /// towards current + h, with `at_impact` ended at the first impact of any gear inside
+    /// towards t_end, with `at_impact` ended at the first impact of any gear inside
     /// it; returns the time reached. A failure leaves the state at `current`.
-    fn step_until(&mut self, current: f64, h: f64, at_impact: bool) -> FmiResult<f64> {
-        let t_end = current + h;
+    fn step_until(&mut self, current: f64, t_end: f64, at_impact: bool) -> FmiResult<f64> {
         let sim = self.sim_mut();
         sim.t = current;
         let before = self
@@ -314,14 +313,14 @@ impl Slave for Instance {
     /// One communication step from the master's point `current`; a failure leaves the
     /// state at `current`.
     fn step(&mut self, current: f64, h: f64) -> FmiResult {
-        self.step_until(current, h, false).map(|_| ())
+        self.step_until(current, current + h, false).map(|_| ())
     }
 
     /// Early return (FMI 3.0): the step ends at the first impact of any gear inside it.
     const STEPS_TO_EVENTS: bool = true;
 
-    fn step_to_event(&mut self, current: f64, h: f64) -> FmiResult<f64> {
-        self.step_until(current, h, true)
+    fn step_to_event(&mut self, current: f64, t_end: f64) -> FmiResult<f64> {
+        self.step_until(current, t_end, true)
     }
 
     // Model Exchange (see `crate::model_exchange`).

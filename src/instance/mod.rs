@@ -174,12 +174,11 @@ impl Instance {
     }
 
     /// A communication step from the master's point `current` (the shell has checked it)
-    /// towards current + h, with `at_impact` ended at the first impact inside it; returns
+    /// towards t_end, with `at_impact` ended at the first impact inside it; returns
     /// the time reached. A failure leaves the state at `current`.
-    fn step_until(&mut self, current: f64, h: f64, at_impact: bool) -> FmiResult<f64> {
+    fn step_until(&mut self, current: f64, t_end: f64, at_impact: bool) -> FmiResult<f64> {
         let sim = self.sim.as_mut().expect("initialised");
         sim.t = current;
-        let t_end = current + h;
         // What the event log compares with, taken only when that log is on.
         let before = self
             .log
@@ -418,14 +417,14 @@ impl Slave for Instance {
     /// One communication step from the master's point `current` (the shell has checked it
     /// against the time); a failure leaves the state at `current`.
     fn step(&mut self, current: f64, h: f64) -> FmiResult {
-        self.step_until(current, h, false).map(|_| ())
+        self.step_until(current, current + h, false).map(|_| ())
     }
 
     /// Early return (FMI 3.0): the step ends at the first impact inside it.
     const STEPS_TO_EVENTS: bool = true;
 
-    fn step_to_event(&mut self, current: f64, h: f64) -> FmiResult<f64> {
-        self.step_until(current, h, true)
+    fn step_to_event(&mut self, current: f64, t_end: f64) -> FmiResult<f64> {
+        self.step_until(current, t_end, true)
     }
 
     /// fmi2SetRealInputDerivatives: the derivatives of θ_M (orders 1, 2) and ω_M (order 1) at
