@@ -86,7 +86,3 @@ def test_early_return_where_the_callback_requests_it(md3, unzipdir3):
     np.testing.assert_array_equal(grid, plain)
     refused, _, _ = stepped(md3, unzipdir3, IntermediateUpdate(request_at=3))
     assert refused == []
-
-
-def test_declares_early_return_after_an_intermediate_update(md3):
-    assert md3.coSimulation.hasEventMode and md3.coSimulation.canReturnEarlyAfterIntermediateUpdate
