@@ -43,7 +43,16 @@ pub struct CoSimulationEvents {
     /// eventModeUsed: the importer enters event mode when a step ends at an event, and after
     /// initialisation.
     pub event_mode_used: bool,
+    /// intermediateUpdate: the importer's callback, called at each of the model's events
+    /// inside a step, with its instanceEnvironment.
+    pub intermediate_update: Option<(IntermediateUpdate, *mut std::ffi::c_void)>,
 }
+
+/// FMI 3.0's fmi3IntermediateUpdateCallback: instanceEnvironment, intermediateUpdateTime,
+/// intermediateVariableSetRequested, intermediateVariableGetAllowed, intermediateStepFinished,
+/// canReturnEarly, earlyReturnRequested (out), earlyReturnTime (out).
+pub type IntermediateUpdate =
+    unsafe extern "C" fn(*mut std::ffi::c_void, f64, bool, bool, bool, bool, *mut bool, *mut f64);
 
 impl<S: Slave> Fmu<S> {
     /// A fresh instance (state Instantiated, start time 0).
@@ -156,9 +165,33 @@ impl<S: Slave> Fmu<S> {
     /// step where the importer allowed early return; returns the time reached (the instance's
     /// time and last successful time).
     pub fn do_step_to_event(&mut self, current: f64, h: f64) -> FmiResult<f64> {
-        match self.events.early_return_allowed {
-            true => self.step_with(current, h, |s| s.step_to_event(current, h)),
+        match self.events.early_return_allowed && S::STEPS_TO_EVENTS {
+            true => self.step_with(current, h, |s| s.step_to_event(current, current + h)),
             false => self.step_with(current, h, |s| s.step(current, h).map(|()| current + h)),
+        }
+    }
+
+    /// fmi3DoStep with an intermediate update: the step taken from event to event (a stop
+    /// continued goes on as the step that never stopped, D41), `at_event` called with the
+    /// time of each; ends there where it returns true. Returns the time reached.
+    pub fn do_step_through_events(
+        &mut self,
+        current: f64,
+        h: f64,
+        mut at_event: impl FnMut(f64) -> bool,
+    ) -> FmiResult<f64> {
+        if !S::STEPS_TO_EVENTS {
+            return self.do_step_to_event(current, h);
+        }
+        // Each part ends at the step's own end: the remainder t_end - t would round.
+        let t_end = current + h;
+        let (mut t, mut h) = (current, h);
+        loop {
+            t = self.step_with(t, h, |s| s.step_to_event(t, t_end))?;
+            if t >= t_end || at_event(t) {
+                return Ok(t);
+            }
+            h = t_end - t;
         }
     }
 

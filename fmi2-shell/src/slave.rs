@@ -112,11 +112,13 @@ pub trait Slave: Clone + Serialize + DeserializeOwned {
     /// model description).
     const STEPS_TO_EVENTS: bool = false;
 
-    /// A step as [`step`](Slave::step), ended at the model's first event inside it where
+    /// A step as [`step`](Slave::step) from `t` (the importer's communication point, or an
+    /// event a step stopped at) to `t_end` (the end of the importer's step, t + h at its
+    /// point), ended at the model's first event inside it where
     /// [`STEPS_TO_EVENTS`](Slave::STEPS_TO_EVENTS) (FMI 3.0's early return); returns the time
-    /// reached, t + h if no event came first.
-    fn step_to_event(&mut self, t: f64, h: f64) -> FmiResult<f64> {
-        self.step(t, h).map(|()| t + h)
+    /// reached, t_end if no event came first. The shell calls it only where STEPS_TO_EVENTS.
+    fn step_to_event(&mut self, t: f64, t_end: f64) -> FmiResult<f64> {
+        self.step(t, t_end - t).map(|()| t_end)
     }
 
     /// Whether a slave decoded by fmi2DeSerializeFMUstate in `state` is one this build can

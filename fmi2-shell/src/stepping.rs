@@ -40,10 +40,10 @@ pub trait Stepping: Slave {
     fn log_steps(&mut self, t: f64);
 
     /// A communication step from the master's point `current` (the shell has checked it)
-    /// towards current + h, with `at_event` ended at the first event inside it; returns the
-    /// time reached. A failure leaves the state at `current`.
-    fn step_until(&mut self, current: f64, h: f64, at_event: bool) -> FmiResult<f64> {
-        let t_end = current + h;
+    /// towards `t_end` (the step's end as the shell computed it, so that a step continued
+    /// after an event ends where the plain one does), with `at_event` ended at the first event
+    /// inside it; returns the time reached. A failure leaves the state at `current`.
+    fn step_until(&mut self, current: f64, t_end: f64, at_event: bool) -> FmiResult<f64> {
         // What the event log compares with, taken only when that log is on.
         let before = self.log().is_on(Self::EVENTS).then(|| self.events());
         match self.advance(current, t_end, at_event) {

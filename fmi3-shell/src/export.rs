@@ -10,6 +10,7 @@ use fmi2_shell::component::{Component, slice_mut};
 use fmi2_shell::contract::fmi3::{Array, EVENT_INDICATOR_VR, INTEGER_VR_OFFSET, TIME_VR};
 use fmi2_shell::contract::{Kind, unknown};
 use fmi2_shell::export::{check_token, create};
+use fmi2_shell::fmu::IntermediateUpdate;
 use fmi2_shell::logger::Logger;
 use fmi2_shell::{
     CoSimulationEvents, EventInfo, FmiError, FmiResult, FmiState, Fmu, Interface, Slave,
@@ -55,7 +56,8 @@ pub unsafe fn instantiate<S: Slave>(
 }
 
 /// fmi3InstantiateCoSimulation: an instance as [`instantiate`] makes it, with the events the
-/// importer allows (eventModeUsed refused for a model whose steps do not end at events).
+/// importer allows (eventModeUsed refused for a model whose steps do not end at events) and
+/// its intermediateUpdate callback (NULL: none).
 #[allow(clippy::too_many_arguments)] // FMI 3.0's arguments, as the exports receive them
 pub unsafe fn instantiate_co_simulation<S: Slave>(
     instance_name: fmi3String,
@@ -66,6 +68,7 @@ pub unsafe fn instantiate_co_simulation<S: Slave>(
     early_return_allowed: bool,
     environment: fmi3InstanceEnvironment,
     log_message: fmi3LogMessageCallback,
+    intermediate_update: fmi3IntermediateUpdateCallback,
 ) -> fmi3Instance {
     let wanted = match event_mode_used && !S::STEPS_TO_EVENTS {
         false => Ok(Interface::CoSimulation),
@@ -91,6 +94,7 @@ pub unsafe fn instantiate_co_simulation<S: Slave>(
         component.fmu.events = CoSimulationEvents {
             early_return_allowed,
             event_mode_used,
+            intermediate_update: intermediate_update.map(|update| (update, environment)),
         };
     }
     instance
@@ -276,9 +280,11 @@ pub unsafe fn answer<T>(out: *mut T, value: T) {
     }
 }
 
-/// fmi3DoStep: the step, ended early at the model's first event inside it where the importer
-/// allowed it (event handling then needed if it uses event mode), and its last successful
-/// time; it never asks for the end of the simulation.
+/// fmi3DoStep: the step and its last successful time; it never asks for the end of the
+/// simulation. Without an intermediateUpdate callback it ends early at the model's first
+/// event inside it where the importer allowed early return; with one it calls it at each
+/// event and ends early there where the importer requests it (event handling then needed if
+/// it uses event mode).
 pub unsafe fn do_step<S: Slave>(
     fmu: &mut Fmu<S>,
     current: f64,
@@ -288,7 +294,16 @@ pub unsafe fn do_step<S: Slave>(
     early_return: *mut bool,
     last_successful_time: *mut f64,
 ) -> FmiResult {
-    let done = fmu.do_step_to_event(current, h);
+    let done = match fmu.events.intermediate_update {
+        None => fmu.do_step_to_event(current, h),
+        Some(update) => {
+            let can_return_early = fmu.events.early_return_allowed;
+            fmu.do_step_through_events(current, h, |t| {
+                // SAFETY: the importer's callback and environment.
+                unsafe { intermediate_update(update, t, can_return_early) }
+            })
+        }
+    };
     let early = done.as_ref().is_ok_and(|&reached| reached < current + h);
     // SAFETY: the importer's pointers.
     unsafe {
@@ -298,6 +313,32 @@ pub unsafe fn do_step<S: Slave>(
         answer(last_successful_time, fmu.last_successful_time());
     }
     done.map(|_| ())
+}
+
+/// The importer's intermediateUpdate at the event at `t`, the step there finished (the
+/// intermediate variables neither set nor got); whether it requests the return there (only
+/// where `can_return_early`). A later earlyReturnTime is not integrated to: the FMU returns
+/// at the event, which FMI 3.0 allows.
+unsafe fn intermediate_update(
+    (update, environment): (IntermediateUpdate, *mut std::ffi::c_void),
+    t: f64,
+    can_return_early: bool,
+) -> bool {
+    let (mut requested, mut early_return_time) = (false, t);
+    // SAFETY: the importer's callback with its environment and two pointers to locals.
+    unsafe {
+        update(
+            environment,
+            t,
+            false,
+            false,
+            true,
+            can_return_early,
+            &mut requested,
+            &mut early_return_time,
+        )
+    };
+    can_return_early && requested
 }
 
 /// fmi3UpdateDiscreteStates's answers.

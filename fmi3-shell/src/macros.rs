@@ -45,9 +45,9 @@ macro_rules! __fmi3_exports {
                         instanceName, instantiationToken, resourcePath, loggingOn, instanceEnvironment, logMessage)
                 }
             }
-            // The model's own early return at its events (where it offers them) and event mode
-            // as the importer allows them; no intermediate update (its variables and callback
-            // go unused: canReturnEarlyAfterIntermediateUpdate is false).
+            // The model's early return at its events (where it offers them), event mode and
+            // the intermediate update at each event as the importer asks for them (no
+            // intermediate variables: none is required).
             #[unsafe(no_mangle)]
             pub unsafe extern "C" fn fmi3InstantiateCoSimulation(
                 instanceName: fmi3String,
@@ -61,11 +61,12 @@ macro_rules! __fmi3_exports {
                 _nRequiredIntermediateVariables: usize,
                 instanceEnvironment: fmi3InstanceEnvironment,
                 logMessage: fmi3LogMessageCallback,
-                _intermediateUpdate: fmi3IntermediateUpdateCallback,
+                intermediateUpdate: fmi3IntermediateUpdateCallback,
             ) -> fmi3Instance {
                 unsafe {
                     e3::instantiate_co_simulation::<S>(instanceName, instantiationToken, resourcePath,
-                        loggingOn, eventModeUsed, earlyReturnAllowed, instanceEnvironment, logMessage)
+                        loggingOn, eventModeUsed, earlyReturnAllowed, instanceEnvironment, logMessage,
+                        intermediateUpdate)
                 }
             }
             /// Scheduled execution is not offered: no instance.

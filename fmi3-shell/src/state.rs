@@ -5,8 +5,10 @@
 //! check), Continuous-Time Mode Model Exchange's. Configuration Mode is fmi2-shell's
 //! [`ConfigurationMode`](fmi2_shell::FmiState::ConfigurationMode), entered from Instantiated
 //! where the model has structural parameters (only fmi3GetUInt64 and fmi3SetUInt64 among the
-//! getters and setters admit it). Reconfiguration, clock activation and intermediate update
-//! modes are never entered: their functions have no state to be called in.
+//! getters and setters admit it). Reconfiguration and clock activation modes are never
+//! entered: their functions have no state to be called in. Intermediate update mode is the
+//! time of the intermediateUpdate callback inside fmi3DoStep, which allows the importer no
+//! call (no intermediate variable to get or set).
 
 pub mod allowed {
     /// The functions FMI 3.0 keeps, in the same states as FMI 2.0 (fmi3EnterInitializationMode

@@ -290,14 +290,14 @@ impl Slave for Instance {
     /// One communication step from the master's point `current`; a failure leaves the
     /// state at `current`.
     fn step(&mut self, current: f64, h: f64) -> FmiResult {
-        self.step_until(current, h, false).map(|_| ())
+        self.step_until(current, current + h, false).map(|_| ())
     }
 
     /// Early return (FMI 3.0): the step ends at the first impact of any gear inside it.
     const STEPS_TO_EVENTS: bool = true;
 
-    fn step_to_event(&mut self, current: f64, h: f64) -> FmiResult<f64> {
-        self.step_until(current, h, true)
+    fn step_to_event(&mut self, current: f64, t_end: f64) -> FmiResult<f64> {
+        self.step_until(current, t_end, true)
     }
 
     // Model Exchange (see `crate::model_exchange`).

@@ -75,16 +75,17 @@ def test_validates_with_enumerations_and_arrays(box3_path, box3_md, box_md):
 EARLY_T_END, EARLY_H, EARLY_TOL = 0.1, 1e-3, 1e-10
 
 
-def stepped_to_impacts(md, unzipdir, vr, event_mode, early_return=True):
+def stepped_to_impacts(md, unzipdir, vr, event_mode, early_return=True, update=None):
     """The default box on the engine (scene B1) over EARLY_T_END in communication steps of
-    EARLY_H at rtol EARLY_TOL, with early return allowed if `early_return`, each early return
+    EARLY_H at rtol EARLY_TOL, with early return allowed if `early_return` and the
+    intermediateUpdate callback `update` (None: NULL), each early return
     followed by a step from where it stopped to the same communication point: the times
     returned early, the state there (every gear's xi, the impacts of all gears, read in
     event mode if `event_mode`), the impact count at the end and every gear's xi, xi' at
     every communication point."""
     fmu = FMU3Slave(guid=md.instantiationToken, unzipDirectory=unzipdir, modelIdentifier="GearboxRattle",
                     instanceName="early")
-    fmu.instantiate(earlyReturnAllowed=early_return, eventModeUsed=event_mode)
+    fmu.instantiate(earlyReturnAllowed=early_return, eventModeUsed=event_mode, intermediateUpdate=update)
     fmu.enterInitializationMode(tolerance=EARLY_TOL, startTime=0.0)
     fmu.setInt64([vr["excitation"]], [1])
     fmu.exitInitializationMode()

@@ -33,7 +33,7 @@ def test_validates_and_declares_fmi3s_types(fmu3_path, md3):
 
     assert validate_fmu(fmu3_path) == []
     assert md3.fmiVersion == "3.0" and md3.modelExchange and md3.coSimulation
-    assert md3.coSimulation.hasEventMode and not md3.coSimulation.canReturnEarlyAfterIntermediateUpdate
+    assert md3.coSimulation.hasEventMode and md3.coSimulation.canReturnEarlyAfterIntermediateUpdate
     types = {v.name: v.type for v in md3.modelVariables}
     for name in ("excitation", "solver", "contact", "stat_regime"):
         assert types[name] == "Enumeration", name

@@ -18,7 +18,8 @@
 //!     canInterpolateInputs: FMI 3.0 has no fmi3SetInputDerivatives), and the adjoint
 //!     derivatives wherever the directional ones are offered (fmi3-shell computes them from
 //!     those). Co-Simulation's `hasEventMode` is the contract's (FMI 3.0 only; absent:
-//!     false); no early return after an intermediate update (there is none).
+//!     false), and so is `canReturnEarlyAfterIntermediateUpdate` (fmi3-shell calls the
+//!     intermediateUpdate callback at the events where a step may end).
 
 use super::{
     Array, Contract, Variable, attributes, esc, initial_unknowns, log_categories_and_experiment,
@@ -206,7 +207,12 @@ pub(super) fn xml(c: &Contract, token: &str) -> String {
         "CoSimulation",
         &m.identifier,
         &c.capabilities,
-        &[("canReturnEarlyAfterIntermediateUpdate", "false")],
+        &[(
+            "canReturnEarlyAfterIntermediateUpdate",
+            &c.capabilities
+                .get("hasEventMode")
+                .map_or("false".into(), value),
+        )],
     );
     units(&mut x, c);
     let mut declared = std::collections::BTreeSet::new();
