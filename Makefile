@@ -87,7 +87,10 @@ demo: $(VENV)/.demo-installed $(HOST_FMU)/GearRattle.fmu
 	$(MAKE) --no-print-directory fmu
 
 ## test: every test: Rust (cargo test) and the FMU as a user runs it (pytest + fmpy)
-test: $(TEST_TARGETS)
+# Two parts at a time: pytest and the fuzzer's run keep one core each, the builds both; each
+# part's output is printed whole when it ends (docs/DEVELOPING.md).
+test:
+	$(MAKE) --no-print-directory -j2 --output-sync=target $(TEST_TARGETS)
 
 # The C-API tests load the FMU's linux64 binary as cargo-zigbuild builds it (mk/portable.mk):
 # the library shipped, and no second release build of it. fmi2-shell's own tests check FMI's
