@@ -88,8 +88,11 @@ demo: $(VENV)/.demo-installed $(HOST_FMU)/GearRattle.fmu
 
 ## test: every test: Rust (cargo test) and the FMU as a user runs it (pytest + fmpy)
 # Two parts at a time: pytest and the fuzzer's run keep one core each, the builds both; each
-# part's output is printed whole when it ends (docs/DEVELOPING.md).
-test:
+# part's output is printed whole when it ends (docs/DEVELOPING.md). What they install (apt-get,
+# rustup, pip, cargo install) is installed first, one at a time: apt-get and rustup take locks.
+TEST_TOOLS := libclang $(VENV)/.installed zig-toolchain llvm-tools windows-toolchain windows-wine \
+	valgrind libtbb fuzz-tools
+test: | $(TEST_TOOLS)
 	$(MAKE) --no-print-directory -j2 --output-sync=target $(TEST_TARGETS)
 
 # The C-API tests load the FMU's linux64 binary as cargo-zigbuild builds it (mk/portable.mk):
