@@ -87,13 +87,19 @@ demo: $(VENV)/.demo-installed $(HOST_FMU)/GearRattle.fmu
 	$(MAKE) --no-print-directory fmu
 
 ## test: every test: Rust (cargo test) and the FMU as a user runs it (pytest + fmpy)
-# Two parts at a time: pytest and the fuzzer's run keep one core each, the builds both; each
-# part's output is printed whole when it ends (docs/DEVELOPING.md). What they install (apt-get,
-# rustup, pip, cargo install) is installed first, one at a time: apt-get and rustup take locks.
+# What the parts install (apt-get, rustup, pip, cargo install) is installed first, one at a
+# time (apt-get and rustup take locks); then the builds, on both cores (cargo spreads them);
+# then the parts two at a time, since pytest and the fuzzer's run keep one core each. Each
+# part's output is printed whole when it ends (docs/DEVELOPING.md).
 TEST_TOOLS := libclang $(VENV)/.installed zig-toolchain llvm-tools windows-toolchain windows-wine \
 	valgrind libtbb fuzz-tools
 test: | $(TEST_TOOLS)
+	$(MAKE) --no-print-directory test-builds
 	$(MAKE) --no-print-directory -j2 --output-sync=target $(TEST_TARGETS)
+
+.PHONY: test-builds
+test-builds: fmu $(FLYWHEEL_FMU)
+	$(CARGO_TEST) --no-run -p gear_rattle -p gearbox_rattle -p fmi2-shell -p fmi3-shell -p flywheel
 
 # The C-API tests load the FMU's linux64 binary as cargo-zigbuild builds it (mk/portable.mk):
 # the library shipped, and no second release build of it. fmi2-shell's own tests check FMI's
