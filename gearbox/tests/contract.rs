@@ -5,6 +5,7 @@
 
 use fmi2_shell::values::Values;
 use fmi2_shell::{Continuous, Fmu, Interface, Slave};
+use gear_rattle::physics::Shaft;
 use gearbox_rattle::contract::{self, Causality, Kind, STATES, VARIABLES, Variable, vr};
 use gearbox_rattle::instance::Instance;
 use gearbox_rattle::simulation::{self, Simulation};
@@ -23,6 +24,16 @@ fn read(sim: &Simulation, v: &Variable) -> u64 {
         Kind::Real => sim.real_output(v.vr).expect("computed").to_bits(),
         _ => sim.integer_output(v.vr).expect("computed") as u64,
     }
+}
+
+/// The shaft's motion with its angle (k = 0), speed (1) or acceleration (2) moved by 1e-3.
+fn bumped(mut shaft: Shaft, k: usize) -> Shaft {
+    match k {
+        0 => shaft.theta += 1e-3,
+        1 => shaft.omega += 1e-3,
+        _ => shaft.alpha += 1e-3,
+    }
+    shaft
 }
 
 /// Every dependent that `change` moves declares `known`; returns how many moved.
@@ -151,26 +162,12 @@ fn model_exchange_moves_only_where_declared() {
         }
         let flywheel = simulation::flywheel_inputs(&values);
         let input_side = simulation::input_side_inputs(&values);
-        for (name, bump) in [("theta_F", 0), ("omega_F", 1), ("alpha_F", 2)] {
-            let _ = moved_only_where_declared(&sim, name, |s| {
-                let mut f = flywheel;
-                match bump {
-                    0 => f.theta += 1e-3,
-                    1 => f.omega += 1e-3,
-                    _ => f.alpha += 1e-3,
-                }
-                s.set_drive_inputs(f, input_side);
+        for (k, motion) in ["theta", "omega", "alpha"].into_iter().enumerate() {
+            let _ = moved_only_where_declared(&sim, &format!("{motion}_F"), |s| {
+                s.set_drive_inputs(bumped(flywheel, k), input_side)
             });
-        }
-        for (name, bump) in [("theta_I", 0), ("omega_I", 1), ("alpha_I", 2)] {
-            let _ = moved_only_where_declared(&sim, name, |s| {
-                let mut i = input_side;
-                match bump {
-                    0 => i.theta += 1e-3,
-                    1 => i.omega += 1e-3,
-                    _ => i.alpha += 1e-3,
-                }
-                s.set_drive_inputs(flywheel, i);
+            let _ = moved_only_where_declared(&sim, &format!("{motion}_I"), |s| {
+                s.set_drive_inputs(flywheel, bumped(input_side, k))
             });
         }
         assert!(moved_only_where_declared(&sim, "omega_out", |s| s.set_output_speed(1.0)) > 0);
