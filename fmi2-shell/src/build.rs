@@ -325,6 +325,16 @@ fn resolve(arrays: &[Array], names: &[String]) -> Vec<String> {
 
 /// Refuses a contract that would give an invalid or ambiguous FMU.
 fn check(c: &Contract) {
+    // The shell's log keeps a model's errors and warnings at these indices.
+    for (i, name) in [
+        (crate::log::ERRORS, "logStatusError"),
+        (crate::log::WARNINGS, "logStatusWarning"),
+    ] {
+        assert!(
+            c.log_categories.get(i).is_some_and(|(n, _)| n == name),
+            "log category {i} must be {name}: errors first, then warnings"
+        );
+    }
     for a in &c.array {
         let n = a.size_parameter();
         assert!(

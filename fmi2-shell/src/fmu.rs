@@ -34,8 +34,10 @@ pub struct Fmu<S> {
     starts: Starts,
 }
 
-/// FMI 3.0's Co-Simulation with events ([`Slave::STEPS_TO_EVENTS`]): what the importer allows
-/// at instantiation.
+/// FMI 3.0's Co-Simulation with events ([`STEPS_TO_EVENTS`]): what the importer allows at
+/// instantiation.
+///
+/// [`STEPS_TO_EVENTS`]: crate::slave::Lifecycle::STEPS_TO_EVENTS
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct CoSimulationEvents {
     /// earlyReturnAllowed: a step may end at the model's first event inside it.
@@ -316,7 +318,7 @@ impl<S: Slave> Fmu<S> {
 mod tests {
     use super::*;
     use crate::contract::{Causality, Kind, Range, Start, Variable, unknown};
-    use crate::slave::Identity;
+    use crate::slave::{Identity, Lifecycle};
 
     const fn var(name: &'static str, vr: u32, causality: Causality) -> Variable {
         Variable {
@@ -355,19 +357,7 @@ mod tests {
         log: Log,
     }
 
-    impl Slave for Integrator {
-        const IDENTITY: Identity = Identity {
-            guid: "{test}",
-            model_identifier: "Integrator",
-            log_categories: &[("logStatusError", ""), ("logStatusWarning", "")],
-            state_magic: *b"TEST",
-            state_version: 1,
-            model_exchange: true,
-            variable,
-            variables: &VARIABLES,
-            arrays: &[],
-        };
-
+    impl Lifecycle for Integrator {
         fn new(_logging_on: bool, interface: Interface) -> Self {
             Integrator {
                 interface,
@@ -392,6 +382,28 @@ mod tests {
             }
         }
 
+        fn step(&mut self, _t: f64, h: f64) -> FmiResult {
+            if self.values[1] < 0.0 {
+                return Err(FmiError::error("u < 0"));
+            }
+            self.values[2] += self.values[0] * self.values[1] * h;
+            Ok(())
+        }
+    }
+
+    impl Slave for Integrator {
+        const IDENTITY: Identity = Identity {
+            guid: "{test}",
+            model_identifier: "Integrator",
+            log_categories: &[("logStatusError", ""), ("logStatusWarning", "")],
+            state_magic: *b"TEST",
+            state_version: 1,
+            model_exchange: true,
+            variable,
+            variables: &VARIABLES,
+            arrays: &[],
+        };
+
         fn get_real(&mut self, vrs: &[u32], out: &mut [f64]) -> FmiResult {
             for (vr, out) in vrs.iter().zip(out) {
                 *out = self.values[variable(Kind::Real, *vr)?.vr as usize];
@@ -403,14 +415,6 @@ mod tests {
             for (vr, value) in vrs.iter().zip(values) {
                 self.values[*vr as usize] = *value;
             }
-            Ok(())
-        }
-
-        fn step(&mut self, _t: f64, h: f64) -> FmiResult {
-            if self.values[1] < 0.0 {
-                return Err(FmiError::error("u < 0"));
-            }
-            self.values[2] += self.values[0] * self.values[1] * h;
             Ok(())
         }
 

@@ -1,7 +1,9 @@
 //! fmi2-shell: the FMI 2.0 layer of GearRattle and its partner FMUs, written once.
 //!
 //! A model is a [`Slave`]: a typed Rust value with its variables, equations and stepping,
-//! free of C types and of FMI's rules. The shell gives it
+//! free of C types and of FMI's rules; one that runs a simulation built from its parameters
+//! is a [`Model`], whose lifecycle (experiment, initialisation, steps) the shell writes
+//! once ([`instance`]). The shell gives it
 //! - the C exports ([`export_co_simulation!`]), each a guard ([`component`]) that checks the
 //!   state table ([`state`]), unpacks the C arguments, catches panics, and hands log
 //!   lines ([`log`]) to the importer's logger ([`logger`]);
@@ -33,6 +35,7 @@ pub mod export;
 pub mod fmu;
 #[cfg(feature = "runtime")]
 pub mod fmu_state;
+pub mod instance;
 pub mod log;
 #[cfg(feature = "runtime")]
 pub mod logger;
@@ -52,8 +55,9 @@ pub mod vectors;
 #[cfg(feature = "runtime")]
 pub use fmi_sys::fmi2;
 pub use fmu::{CoSimulationEvents, Fmu};
+pub use instance::{Core, Model};
 pub use log::{Log, Message};
-pub use slave::{EventInfo, Identity, Interface, Slave};
+pub use slave::{EventInfo, Identity, Interface, Lifecycle, Slave};
 pub use state::FmiState;
 pub use status::{FmiError, FmiResult, Status};
 pub use stepping::Stepping;

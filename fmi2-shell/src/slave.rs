@@ -57,16 +57,12 @@ pub struct EventInfo {
     pub next_event_time: Option<f64>,
 }
 
-/// What a model supplies to the shell: its variables, its equations and stepping, its own
-/// validation. The FMI rules (the state machine's transitions, the time checks, which
-/// variables may be set in which state, the instance's time and last successful time) are
-/// the shell's ([`Fmu`]), which calls these methods only where those rules admit the call.
-/// Everything but its [`Log`] is part of the FMU state (clone and serde).
+/// How an instance is made, set up, initialised and stepped. The shell implements it for
+/// every model that keeps its experiment and simulation in a [`Core`]; a model without
+/// either (a partner whose simulation is its parameters) implements it itself.
 ///
-/// [`Fmu`]: crate::fmu::Fmu
-pub trait Slave: Clone + Serialize + DeserializeOwned {
-    const IDENTITY: Identity;
-
+/// [`Core`]: crate::instance::Core
+pub trait Lifecycle: Sized {
     /// A fresh instance for `interface` (start values), logging as `logging_on` says.
     fn new(logging_on: bool, interface: Interface) -> Self;
 
@@ -87,6 +83,38 @@ pub trait Slave: Clone + Serialize + DeserializeOwned {
     /// the start time. On an error the shell keeps the instance in initialisation mode.
     fn exit_initialization_mode(&mut self) -> FmiResult;
 
+    /// One communication step from `t` (the importer's communication point, checked against
+    /// the instance's time) to `t + h` (h finite, > 0 and resolved there). On an error the
+    /// shell moves the instance into [`FmiState::Error`]; on success its time is `t + h`.
+    fn step(&mut self, t: f64, h: f64) -> FmiResult;
+
+    /// Whether [`step_to_event`](Lifecycle::step_to_event) may end a step early: the model's
+    /// events in Co-Simulation (FMI 3.0's early return and event mode, `hasEventMode` in its
+    /// model description).
+    const STEPS_TO_EVENTS: bool = false;
+
+    /// A step as [`step`](Lifecycle::step) from `t` (the importer's communication point, or
+    /// an event a step stopped at) to `t_end` (the end of the importer's step, t + h at its
+    /// point), ended at the model's first event inside it where
+    /// [`STEPS_TO_EVENTS`](Lifecycle::STEPS_TO_EVENTS) (FMI 3.0's early return); returns the
+    /// time reached, t_end if no event came first. The shell calls it only where
+    /// STEPS_TO_EVENTS.
+    fn step_to_event(&mut self, t: f64, t_end: f64) -> FmiResult<f64> {
+        self.step(t, t_end - t).map(|()| t_end)
+    }
+}
+
+/// What a model supplies to the shell: its variables, its equations and stepping (its
+/// [`Lifecycle`]), its own validation. The FMI rules (the state machine's transitions, the
+/// time checks, which variables may be set in which state, the instance's time and last
+/// successful time) are the shell's ([`Fmu`]), which calls these methods only where those
+/// rules admit the call. Everything but its [`Log`] is part of the FMU state (clone and
+/// serde).
+///
+/// [`Fmu`]: crate::fmu::Fmu
+pub trait Slave: Lifecycle + Clone + Serialize + DeserializeOwned {
+    const IDENTITY: Identity;
+
     fn get_real(&mut self, vrs: &[u32], out: &mut [f64]) -> FmiResult;
 
     fn get_integer(&mut self, vrs: &[u32], _out: &mut [i32]) -> FmiResult {
@@ -100,25 +128,6 @@ pub trait Slave: Clone + Serialize + DeserializeOwned {
     /// fmi2SetInteger in `state`, checked as [`set_real`](Slave::set_real).
     fn set_integer(&mut self, _state: FmiState, vrs: &[u32], _values: &[i32]) -> FmiResult {
         no_variables("Integer", vrs)
-    }
-
-    /// One communication step from `t` (the importer's communication point, checked against
-    /// the instance's time) to `t + h` (h finite, > 0 and resolved there). On an error the
-    /// shell moves the instance into [`FmiState::Error`]; on success its time is `t + h`.
-    fn step(&mut self, t: f64, h: f64) -> FmiResult;
-
-    /// Whether [`step_to_event`](Slave::step_to_event) may end a step early: the model's
-    /// events in Co-Simulation (FMI 3.0's early return and event mode, `hasEventMode` in its
-    /// model description).
-    const STEPS_TO_EVENTS: bool = false;
-
-    /// A step as [`step`](Slave::step) from `t` (the importer's communication point, or an
-    /// event a step stopped at) to `t_end` (the end of the importer's step, t + h at its
-    /// point), ended at the model's first event inside it where
-    /// [`STEPS_TO_EVENTS`](Slave::STEPS_TO_EVENTS) (FMI 3.0's early return); returns the time
-    /// reached, t_end if no event came first. The shell calls it only where STEPS_TO_EVENTS.
-    fn step_to_event(&mut self, t: f64, t_end: f64) -> FmiResult<f64> {
-        self.step(t, t_end - t).map(|()| t_end)
     }
 
     /// Whether a slave decoded by fmi2DeSerializeFMUstate in `state` is one this build can
@@ -196,9 +205,11 @@ pub trait Slave: Clone + Serialize + DeserializeOwned {
     }
 
     /// fmi2CompletedIntegratorStep: whether the importer must enter event mode now (the
-    /// shell then takes the current time as the last successful one).
+    /// shell then takes the current time as the last successful one). The continuous part
+    /// takes the step as done ([`Continuous::completed_integrator_step`]); no event follows.
     fn completed_integrator_step(&mut self) -> FmiResult<bool> {
-        Err(unsupported("fmi2CompletedIntegratorStep"))
+        self.continuous()?.completed_integrator_step();
+        Ok(false)
     }
 }
 

@@ -8,8 +8,12 @@ use crate::slave::Slave;
 use crate::status::{FmiError, FmiResult};
 use std::fmt::Display;
 
-/// What a model supplies to [`Stepping::step_until`], the step of its [`Slave::step`] and
-/// [`Slave::step_to_event`].
+/// What a model supplies to [`Stepping::step_until`], the step of its
+/// [`Lifecycle::step`] and [`Lifecycle::step_to_event`] (a [`Model`]'s, written by the shell).
+///
+/// [`Lifecycle::step`]: crate::slave::Lifecycle::step
+/// [`Lifecycle::step_to_event`]: crate::slave::Lifecycle::step_to_event
+/// [`Model`]: crate::instance::Model
 pub trait Stepping: Slave {
     /// What logEvents compares the end of a step with: the model's event counts before it.
     type Events;

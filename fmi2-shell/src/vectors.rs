@@ -25,6 +25,9 @@ pub trait Continuous {
     fn derivatives(&self) -> Self::States;
 
     fn event_indicators(&self) -> Self::Indicators;
+
+    /// fmi2CompletedIntegratorStep: the importer has accepted its step up to now.
+    fn completed_integrator_step(&mut self) {}
 }
 
 /// A model's vector: an array of a fixed length.

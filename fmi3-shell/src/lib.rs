@@ -20,7 +20,7 @@
 //! Not offered: intermediate variables, clocks, scheduled execution, and configuration mode for
 //! a model without structural parameters; their functions refuse with a log line.
 //!
-//! [`Slave::step_to_event`]: fmi2_shell::Slave::step_to_event
+//! [`Slave::step_to_event`]: fmi2_shell::Lifecycle::step_to_event
 //!
 //! [`Slave`]: fmi2_shell::Slave
 //! [`Fmu`]: fmi2_shell::Fmu

@@ -8,52 +8,23 @@ use serde::{Deserialize, Serialize};
 use crate::contract::{self, Causality, Kind, LOG_CATEGORIES, VARIABLES, vr};
 use crate::outputs::Now;
 use crate::simulation::{self, Simulation};
-use fmi2_shell::values::Values;
 use fmi2_shell::{
-    Continuous, EventInfo, FmiError, FmiResult, FmiState, Identity, Interface, Log, Slave, Status,
-    Stepping,
+    Continuous, Core, EventInfo, FmiError, FmiResult, FmiState, Identity, Interface, Model, Slave,
+    Status, Stepping,
 };
 use gear_rattle::integrator::SolverError;
-
-/// The contract's log categories by role (errors and warnings first, as the shell wants).
-const EVENTS: usize = contract::log::logEvents;
-const STEPS: usize = contract::log::logStep;
-const _: () = assert!(contract::log::logStatusError == fmi2_shell::log::ERRORS);
-const _: () = assert!(contract::log::logStatusWarning == fmi2_shell::log::WARNINGS);
 
 /// One FMU instance. Everything but the log is its FMU state: parameters, inputs, the
 /// gearbox with its solver, state, windows and time.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Instance {
-    interface: Interface,
-    values: Values,
-    start_time: f64,
-    tolerance: Option<f64>,
-    /// The running gearbox; built at fmi2ExitInitializationMode (and for reads during
-    /// initialisation, from the values set so far).
-    sim: Option<Simulation>,
-    #[serde(skip)]
-    log: Log,
+    core: Core<Simulation>,
 }
 
 impl Instance {
     /// The running gearbox, once initialised.
     pub fn simulation(&self) -> Option<&Simulation> {
-        self.sim.as_ref()
-    }
-
-    fn build(&self) -> FmiResult<Simulation> {
-        let rtol = self.tolerance.unwrap_or(contract::DEFAULT_TOLERANCE);
-        let model_exchange = self.interface == Interface::ModelExchange;
-        Simulation::new(&self.values, self.start_time, rtol, model_exchange)
-    }
-
-    /// The running simulation, or during initialisation one built from the values so far.
-    fn current(&mut self) -> FmiResult<&Simulation> {
-        if self.sim.is_none() {
-            self.sim = Some(self.build()?);
-        }
-        Ok(self.sim.as_ref().expect("built above"))
+        self.core.sim.as_ref()
     }
 
     /// Builds the simulation (as [`Self::current`]) when `vrs` asks for a computed variable, so
@@ -65,24 +36,20 @@ impl Instance {
         Ok(())
     }
 
-    fn sim_mut(&mut self) -> &mut Simulation {
-        self.sim.as_mut().expect("initialised")
-    }
-
     /// New inputs in `state`: during initialisation the start is rebuilt; once running, the
     /// drive's inputs and the output shaft's speed take effect at once.
     fn inputs_changed(&mut self, state: FmiState, drive: bool, output_speed: bool) {
         if !state.is_initialised() {
-            self.sim = None;
+            self.core.sim = None;
             return;
         }
-        let values = &self.values;
+        let values = &self.core.values;
         let (flywheel, input_side) = (
             simulation::flywheel_inputs(values),
             simulation::input_side_inputs(values),
         );
         let omega_out = values.real(vr::omega_out);
-        let sim = self.sim_mut();
+        let sim = self.core.running_mut();
         match state {
             FmiState::EventMode | FmiState::ContinuousTimeMode if drive => {
                 sim.set_drive_inputs(flywheel, input_side);
@@ -99,16 +66,47 @@ impl Instance {
     }
 }
 
+/// The gearbox built from the parameters and the experiment; the lifecycle around it is
+/// fmi2-shell's ([`Model`]).
+impl Model for Instance {
+    type Simulation = Simulation;
+    const DEFAULT_TOLERANCE: f64 = contract::DEFAULT_TOLERANCE;
+
+    fn with_core(core: Core<Simulation>) -> Self {
+        Instance { core }
+    }
+
+    fn core(&self) -> &Core<Simulation> {
+        &self.core
+    }
+
+    fn core_mut(&mut self) -> &mut Core<Simulation> {
+        &mut self.core
+    }
+
+    /// Checks every parameter (the contract's ranges, then docs/GEARBOX.md's rules between
+    /// them: k_2 ≥ k_1, ν_100 < ν_40, ...) and builds the start.
+    fn build(&self, rtol: f64) -> FmiResult<Simulation> {
+        let model_exchange = self.core.interface == Interface::ModelExchange;
+        Simulation::new(
+            &self.core.values,
+            self.core.start_time,
+            rtol,
+            model_exchange,
+        )
+    }
+}
+
 /// The co-simulation step of fmi2-shell's [`Stepping`], on the running gearbox.
 impl Stepping for Instance {
     /// The impacts per gear and the damper's stage.
     type Events = ([[u64; 2]; 8], i32);
     type StepError = SolverError;
-    const EVENTS: usize = EVENTS;
-    const STEPS: usize = STEPS;
+    const EVENTS: usize = contract::log::logEvents;
+    const STEPS: usize = contract::log::logStep;
 
     fn events(&self) -> Self::Events {
-        let (gearbox, _) = self.sim.as_ref().expect("initialised").gearbox();
+        let (gearbox, _) = self.core.running().gearbox();
         (
             gearbox.gears.map(|g| g.impacts.count),
             gearbox.regions().0.sign(),
@@ -118,18 +116,22 @@ impl Stepping for Instance {
     /// The gearbox from `current` towards `t_end`, with `at_event` ended at the first
     /// impact of any gear inside.
     fn advance(&mut self, current: f64, t_end: f64, at_event: bool) -> Result<f64, SolverError> {
-        let sim = self.sim_mut();
+        let sim = self.core.running_mut();
         sim.t = current;
         sim.step_until(t_end, at_event)
     }
 
     fn is_finite(&self) -> bool {
-        let (_, y) = self.sim.as_ref().expect("initialised").gearbox();
+        let (_, y) = self.core.running().gearbox();
         y.iter().all(|v| v.is_finite())
     }
 
     fn sync_inputs(&mut self) {
-        let Some((flywheel, shaft)) = self.sim.as_ref().and_then(Simulation::extrapolated_inputs)
+        let Some((flywheel, shaft)) = self
+            .core
+            .sim
+            .as_ref()
+            .and_then(Simulation::extrapolated_inputs)
         else {
             return;
         };
@@ -138,13 +140,13 @@ impl Stepping for Instance {
         } else {
             [vr::theta_I, vr::omega_I]
         };
-        self.values.set_real(theta, shaft.theta);
-        self.values.set_real(omega, shaft.omega);
+        self.core.values.set_real(theta, shaft.theta);
+        self.core.values.set_real(omega, shaft.omega);
     }
 
     /// logEvents after a step: the impacts it counted per gear and the damper's stage.
     fn log_events(&mut self, t_end: f64, before: Self::Events) {
-        let (gearbox, _) = self.sim.as_ref().expect("initialised").gearbox();
+        let (gearbox, _) = self.core.running().gearbox();
         let (stage, _) = gearbox.regions();
         let lines: Vec<String> = (0..gearbox.n_gears())
             .filter_map(|i| {
@@ -167,16 +169,16 @@ impl Stepping for Instance {
             }))
             .collect();
         for line in lines {
-            self.log.log(Status::Ok, EVENTS, || line);
+            self.core.log.log(Status::Ok, Self::EVENTS, || line);
         }
     }
 
     /// logStep after a step: the solver's work so far.
     fn log_steps(&mut self, t_end: f64) {
-        let sim = self.sim.as_ref().expect("initialised");
+        let sim = self.core.running();
         let (stats, h, implicit) = (sim.stats(), sim.proposed_step(), sim.is_implicit());
         let method = if implicit { "Radau IIA" } else { "DOPRI5" };
-        self.log.log(Status::Ok, STEPS, || {
+        self.core.log.log(Status::Ok, Self::STEPS, || {
             format!(
                 "t = {t_end}: {} accepted ({} by Radau IIA), {} rejected steps, {} edges, {} rhs evaluations in total; next step {h:e} s by {method}",
                 stats.accepted, stats.implicit_steps, stats.rejected, stats.edges, stats.rhs_evals
@@ -191,53 +193,16 @@ impl Slave for Instance {
         model_identifier: contract::MODEL_IDENTIFIER,
         log_categories: LOG_CATEGORIES,
         state_magic: *b"GBXS",
-        state_version: 1,
+        state_version: 2,
         model_exchange: true,
         variable: contract::variable,
         variables: contract::VARIABLES,
         arrays: contract::FMI3_ARRAYS,
     };
 
-    fn new(logging_on: bool, interface: Interface) -> Self {
-        Instance {
-            interface,
-            values: Values::start(VARIABLES),
-            start_time: 0.0,
-            tolerance: None,
-            sim: None,
-            log: Log::new(LOG_CATEGORIES, logging_on),
-        }
-    }
-
-    fn interface(&self) -> Interface {
-        self.interface
-    }
-
-    fn log(&mut self) -> &mut Log {
-        &mut self.log
-    }
-
-    fn setup_experiment(&mut self, tolerance: Option<f64>, start_time: f64) {
-        self.start_time = start_time;
-        self.tolerance = tolerance;
-        self.sim = None;
-    }
-
-    fn enter_initialization_mode(&mut self) {
-        self.sim = None;
-    }
-
-    /// Checks every parameter (the contract's ranges, then docs/GEARBOX.md's rules between them:
-    /// k_2 ≥ k_1, ν_100 < ν_40, ...) and builds the start; an invalid parameter is refused
-    /// and the instance stays in initialisation mode, where it can be corrected.
-    fn exit_initialization_mode(&mut self) -> FmiResult {
-        self.sim = Some(self.build()?);
-        Ok(())
-    }
-
     fn get_real(&mut self, vrs: &[u32], out: &mut [f64]) -> FmiResult {
         self.build_if_computed(Kind::Real, vrs)?;
-        let now = self.sim.as_ref().map(Now::new);
+        let now = self.core.sim.as_ref().map(Now::new);
         for (vr, out) in vrs.iter().zip(out) {
             let var = contract::variable(Kind::Real, *vr)?;
             *out = match var.causality {
@@ -245,7 +210,7 @@ impl Slave for Instance {
                     .as_ref()
                     .and_then(|now| now.real(*vr))
                     .expect("every computed Real variable of the contract is computed"),
-                _ => self.values.real(*vr),
+                _ => self.core.values.real(*vr),
             };
             if !out.is_finite() {
                 return Err(FmiError::error(format!(
@@ -259,9 +224,10 @@ impl Slave for Instance {
 
     fn get_integer(&mut self, vrs: &[u32], out: &mut [i32]) -> FmiResult {
         self.build_if_computed(Kind::Integer, vrs)?;
-        let now = self.sim.as_ref().map(Now::new);
+        let now = self.core.sim.as_ref().map(Now::new);
         let output = |vr| now.as_ref()?.integer(vr);
-        self.values
+        self.core
+            .values
             .get_integer(contract::variable, vrs, out, output)
     }
 
@@ -269,7 +235,7 @@ impl Slave for Instance {
     fn set_real(&mut self, state: FmiState, vrs: &[u32], values: &[f64]) -> FmiResult {
         let (mut drive, mut output_speed) = (false, false);
         for (vr, value) in vrs.iter().zip(values) {
-            self.values.set_real(*vr, *value);
+            self.core.values.set_real(*vr, *value);
             drive |= (vr::theta_F..=vr::alpha_I).contains(vr);
             output_speed |= *vr == vr::omega_out;
         }
@@ -278,45 +244,25 @@ impl Slave for Instance {
     }
 
     fn set_integer(&mut self, state: FmiState, vrs: &[u32], values: &[i32]) -> FmiResult {
-        for (vr, value) in vrs.iter().zip(values) {
-            self.values.set_integer(*vr, i64::from(*value));
-        }
-        if !state.is_initialised() {
-            self.sim = None;
-        }
-        Ok(())
-    }
-
-    /// One communication step from the master's point `current`; a failure leaves the
-    /// state at `current`.
-    fn step(&mut self, current: f64, h: f64) -> FmiResult {
-        self.step_until(current, current + h, false).map(|_| ())
-    }
-
-    /// Early return (FMI 3.0): the step ends at the first impact of any gear inside it.
-    const STEPS_TO_EVENTS: bool = true;
-
-    fn step_to_event(&mut self, current: f64, t_end: f64) -> FmiResult<f64> {
-        self.step_until(current, t_end, true)
+        self.core.set_integer(state, vrs, values)
     }
 
     // Model Exchange (see `crate::model_exchange`).
 
     fn set_time(&mut self, t: f64) -> FmiResult {
-        self.sim_mut().set_time(t);
+        self.core.running_mut().set_time(t);
         Ok(())
     }
 
     fn continuous(&mut self) -> FmiResult<&mut impl Continuous> {
-        self.current()?;
-        Ok(self.sim_mut())
+        self.current()
     }
 
     fn new_discrete_states(&mut self) -> FmiResult<EventInfo> {
-        let t = self.sim.as_ref().expect("initialised").t;
+        let t = self.core.running().t;
         let before = self.events();
-        let next_event_time = self.sim_mut().update_discrete_states();
-        if self.log.is_on(EVENTS) {
+        let next_event_time = self.core.running_mut().update_discrete_states();
+        if self.core.log.is_on(Self::EVENTS) {
             self.log_events(t, before);
         }
         Ok(EventInfo {
@@ -325,18 +271,13 @@ impl Slave for Instance {
         })
     }
 
-    fn completed_integrator_step(&mut self) -> FmiResult<bool> {
-        self.sim_mut().completed_integrator_step();
-        Ok(false)
-    }
-
     /// A decoded state must be one this build can run: an initialised instance has its
     /// simulation, of its interface, with 1 to 8 gears and a finite time and state; the
     /// values their full length and finite.
     fn check_decoded(&self, state: FmiState) -> FmiResult {
-        self.values.check(VARIABLES)?;
+        self.core.values.check(VARIABLES)?;
         let refuse = |why: String| Err(FmiError::error(why));
-        match &self.sim {
+        match &self.core.sim {
             None if state.is_initialised() => refuse(format!(
                 "an initialised instance (state {state:?}) without a simulation"
             )),
@@ -345,10 +286,10 @@ impl Slave for Instance {
                 let n = gearbox.n_gears();
                 if !(1..=gear_rattle::gearbox::MAX_GEARS).contains(&n) {
                     refuse(format!("a gearbox of {n} gears"))
-                } else if sim.model_exchange != (self.interface == Interface::ModelExchange) {
+                } else if sim.model_exchange != (self.core.interface == Interface::ModelExchange) {
                     refuse(format!(
                         "a {:?} instance with the other interface's simulation",
-                        self.interface
+                        self.core.interface
                     ))
                 } else if !(sim.t.is_finite() && y.iter().all(|v| v.is_finite())) {
                     refuse(format!("a time {} or a state that is not finite", sim.t))

@@ -138,6 +138,15 @@ impl Continuous for Simulation {
         }
         z
     }
+
+    /// After an accepted step of the importer: each gear's |a| there for the window's peak.
+    fn completed_integrator_step(&mut self) {
+        let t = self.t;
+        if let Run::Windowed(k) = &mut self.run {
+            let y = windowed::head(&k.y);
+            k.system.sample_accelerations(t, &y);
+        }
+    }
 }
 
 impl Simulation {
@@ -191,15 +200,6 @@ impl Simulation {
             self.open_window();
         }
         matches!(self.run, Run::Lean(_)).then_some(self.window_from)
-    }
-
-    /// After an accepted step of the importer: each gear's |a| there for the window's peak.
-    pub fn completed_integrator_step(&mut self) {
-        let t = self.t;
-        if let Run::Windowed(k) = &mut self.run {
-            let y = windowed::head(&k.y);
-            k.system.sample_accelerations(t, &y);
-        }
     }
 }
 

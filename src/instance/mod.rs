@@ -14,16 +14,9 @@ use crate::contract::{self, Causality, Kind, LOG_CATEGORIES, vr};
 use crate::integrator::SolverError;
 use crate::physics::Shaft;
 use crate::rattle::Impacts;
-use fmi2_shell::values::Values;
-use fmi2_shell::{Continuous, EventInfo, Identity, Interface, Log, Slave, Stepping};
+use fmi2_shell::{Continuous, Core, EventInfo, Identity, Interface, Model, Slave, Stepping};
 
 use serde::{Deserialize, Serialize};
-
-/// The contract's log categories by role (errors and warnings first, as the shell wants).
-const EVENTS: usize = contract::log::logEvents;
-const STEPS: usize = contract::log::logStep;
-const _: () = assert!(contract::log::logStatusError == fmi2_shell::log::ERRORS);
-const _: () = assert!(contract::log::logStatusWarning == fmi2_shell::log::WARNINGS);
 
 /// The model of one FMU instance. Everything but the logging settings and the queued lines is
 /// part of its FMU state (fmi2GetFMUstate / fmi2SerializeFMUstate): parameters, inputs, the
@@ -31,44 +24,18 @@ const _: () = assert!(contract::log::logStatusWarning == fmi2_shell::log::WARNIN
 /// energies.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Instance {
-    /// Co-Simulation, or Model Exchange (the importer integrates; see `model_exchange`).
-    interface: Interface,
-    values: Values,
+    /// The values, the experiment, the running gear pair (Model Exchange: see
+    /// `model_exchange`) and the log.
+    core: Core<Simulation>,
     /// dτ_in/dt from fmi2SetRealInputDerivatives [N m/s] (0 until set: a held torque); the
     /// derivatives of θ_M and ω_M are kept as the inputs omega_M and alpha_M.
     tau_in_rate: f64,
-    start_time: f64,
-    tolerance: Option<f64>,
-    /// The running model; built at fmi2ExitInitializationMode (and for reads during
-    /// initialisation, from the values set so far).
-    sim: Option<Simulation>,
-    /// Log categories switched on and lines waiting for the importer's logger.
-    #[serde(skip)]
-    log: Log,
 }
 
 impl Instance {
     /// Queues a line for the logger if its category is on.
     fn log_line(&mut self, status: Status, category: usize, text: impl FnOnce() -> String) {
-        self.log.log(status, category, text);
-    }
-
-    fn build(&self) -> FmiResult<Simulation> {
-        let rtol = self.tolerance.unwrap_or(contract::DEFAULT_TOLERANCE);
-        // Model Exchange's states are every quadrature of the contract.
-        let carry = match self.interface {
-            Interface::CoSimulation => Carry::Asked,
-            Interface::ModelExchange => Carry::All,
-        };
-        Simulation::new(&self.values, self.tau_in_rate, self.start_time, rtol, carry)
-    }
-
-    /// The running simulation, or during initialisation one built from the values so far.
-    fn current(&mut self) -> FmiResult<&Simulation> {
-        if self.sim.is_none() {
-            self.sim = Some(self.build()?);
-        }
-        Ok(self.sim.as_ref().expect("built above"))
+        self.core.log.log(status, category, text);
     }
 
     /// A value that overflowed is never handed out with fmi2OK.
@@ -94,11 +61,11 @@ impl Instance {
     fn real_value(&mut self, vr: u32) -> FmiResult<f64> {
         Ok(match contract::variable(Kind::Real, vr)?.causality {
             Causality::Output | Causality::Local => {
-                let interface = self.interface;
+                let interface = self.core.interface;
                 Self::output(self.current()?, interface, vr)
                     .expect("every computed Real variable of the contract is computed")
             }
-            _ => self.values.real(vr),
+            _ => self.core.values.real(vr),
         })
     }
 
@@ -107,27 +74,27 @@ impl Instance {
     /// simulation (inputs take effect at once).
     fn inputs_changed(&mut self, state: FmiState) {
         // Co-Simulation's event mode (FMI 3.0) sets inputs between steps, as step mode does.
-        let stepping = self.interface == Interface::CoSimulation;
+        let stepping = self.core.interface == Interface::CoSimulation;
         match state {
             FmiState::EventMode | FmiState::ContinuousTimeMode if !stepping => {
                 let (shaft, tau, rate) = self.shaft_inputs();
-                let sim = self.sim.as_mut().expect("initialised");
+                let sim = self.core.running_mut();
                 sim.set_shaft_inputs(shaft);
                 sim.set_torque(tau, rate);
             }
             FmiState::StepComplete | FmiState::EventMode => {
                 let (shaft, tau, rate) = self.shaft_inputs();
-                let sim = self.sim.as_mut().expect("initialised");
+                let sim = self.core.running_mut();
                 let before = sim.impacts();
                 sim.set_shaft(shaft);
                 sim.set_torque(tau, rate);
                 if before != sim.impacts() {
-                    self.log_line(Status::Ok, EVENTS, || {
+                    self.log_line(Status::Ok, Self::EVENTS, || {
                         "new inputs moved the gear pair across a contact onset".to_string()
                     });
                 }
             }
-            FmiState::InitializationMode => self.sim = None,
+            FmiState::InitializationMode => self.core.sim = None,
             _ => {}
         }
     }
@@ -136,20 +103,11 @@ impl Instance {
     /// mode).
     fn shaft_inputs(&self) -> (Shaft, f64, f64) {
         let shaft = Shaft {
-            theta: self.values.real(vr::theta_M),
-            omega: self.values.real(vr::omega_M),
-            alpha: self.values.real(vr::alpha_M),
+            theta: self.core.values.real(vr::theta_M),
+            omega: self.core.values.real(vr::omega_M),
+            alpha: self.core.values.real(vr::alpha_M),
         };
-        (shaft, self.values.real(vr::tau_in), self.tau_in_rate)
-    }
-
-    /// The running simulation, for the calls of Model Exchange.
-    fn model_exchange(&mut self) -> &mut Simulation {
-        self.sim.as_mut().expect("initialised")
-    }
-
-    fn simulation(&self) -> &Simulation {
-        self.sim.as_ref().expect("initialised")
+        (shaft, self.core.values.real(vr::tau_in), self.tau_in_rate)
     }
 
     fn method_name(sim: &Simulation) -> &'static str {
@@ -161,29 +119,61 @@ impl Instance {
     }
 }
 
+/// The gear pair built from the parameters and the experiment; the lifecycle around it is
+/// fmi2-shell's ([`Model`]).
+impl Model for Instance {
+    type Simulation = Simulation;
+    const DEFAULT_TOLERANCE: f64 = contract::DEFAULT_TOLERANCE;
+
+    fn with_core(core: Core<Simulation>) -> Self {
+        Instance {
+            core,
+            tau_in_rate: 0.0,
+        }
+    }
+
+    fn core(&self) -> &Core<Simulation> {
+        &self.core
+    }
+
+    fn core_mut(&mut self) -> &mut Core<Simulation> {
+        &mut self.core
+    }
+
+    fn build(&self, rtol: f64) -> FmiResult<Simulation> {
+        // Model Exchange's states are every quadrature of the contract.
+        let carry = match self.core.interface {
+            Interface::CoSimulation => Carry::Asked,
+            Interface::ModelExchange => Carry::All,
+        };
+        let (values, t0) = (&self.core.values, self.core.start_time);
+        Simulation::new(values, self.tau_in_rate, t0, rtol, carry)
+    }
+}
+
 /// The co-simulation step of fmi2-shell's [`Stepping`], on the running gear pair.
 impl Stepping for Instance {
     /// The impacts and the hand-overs of the method.
     type Events = (Impacts, u64);
     type StepError = SolverError;
-    const EVENTS: usize = EVENTS;
-    const STEPS: usize = STEPS;
+    const EVENTS: usize = contract::log::logEvents;
+    const STEPS: usize = contract::log::logStep;
 
     fn events(&self) -> Self::Events {
-        let sim = self.simulation();
+        let sim = self.core.running();
         (sim.impacts(), sim.stats().switches)
     }
 
     /// The gear pair from `current` towards `t_end`, with `at_event` ended at the first
     /// impact inside.
     fn advance(&mut self, current: f64, t_end: f64, at_event: bool) -> Result<f64, SolverError> {
-        let sim = self.sim.as_mut().expect("initialised");
+        let sim = self.core.running_mut();
         sim.t = current;
         sim.step_until(t_end, at_event)
     }
 
     fn is_finite(&self) -> bool {
-        let sim = self.simulation();
+        let sim = self.core.running();
         let (xi, xi_dot) = (sim.real_output(vr::xi), sim.real_output(vr::xi_dot));
         xi.is_some_and(f64::is_finite) && xi_dot.is_some_and(f64::is_finite)
     }
@@ -191,19 +181,21 @@ impl Stepping for Instance {
     /// `theta_M` and `omega_M` (inputs mode) or `tau_in` (torque mode) follow the
     /// extrapolation (see `Simulation::step_to`).
     fn sync_inputs(&mut self) {
-        match self.sim.as_ref().map(|sim| sim.drive) {
+        match self.core.sim.as_ref().map(|sim| sim.drive) {
             Some(simulation::Drive::Inputs(shaft)) => {
-                self.values.set_real(vr::theta_M, shaft.theta);
-                self.values.set_real(vr::omega_M, shaft.omega);
+                self.core.values.set_real(vr::theta_M, shaft.theta);
+                self.core.values.set_real(vr::omega_M, shaft.omega);
             }
-            Some(simulation::Drive::Torque { tau, .. }) => self.values.set_real(vr::tau_in, tau),
+            Some(simulation::Drive::Torque { tau, .. }) => {
+                self.core.values.set_real(vr::tau_in, tau)
+            }
             _ => {}
         }
     }
 
     /// logEvents after a step: the impacts it counted and a hand-over of the method.
     fn log_events(&mut self, t_end: f64, (impacts_before, switches_before): Self::Events) {
-        let sim = self.simulation();
+        let sim = self.core.running();
         let (impacts, switched) = (sim.impacts(), sim.stats().switches != switches_before);
         let method = Self::method_name(sim);
         let new = [
@@ -211,7 +203,7 @@ impl Stepping for Instance {
             impacts.count[1] - impacts_before.count[1],
         ];
         if new != [0, 0] {
-            self.log_line(Status::Ok, EVENTS, || {
+            self.log_line(Status::Ok, Self::EVENTS, || {
                 format!(
                     "t = {t_end}: {} impact(s) on F+, {} on F-, last at |xi'| = {:e} m/s",
                     new[0], new[1], impacts.last_speed
@@ -219,7 +211,7 @@ impl Stepping for Instance {
             });
         }
         if switched {
-            self.log_line(Status::Ok, EVENTS, || {
+            self.log_line(Status::Ok, Self::EVENTS, || {
                 format!("t = {t_end}: integration method handed over, now {method}")
             });
         }
@@ -227,9 +219,9 @@ impl Stepping for Instance {
 
     /// logStep after a step: the solver's work so far.
     fn log_steps(&mut self, t_end: f64) {
-        let sim = self.simulation();
+        let sim = self.core.running();
         let (stats, h_next, method) = (sim.stats(), sim.proposed_step(), Self::method_name(sim));
-        self.log_line(Status::Ok, STEPS, || {
+        self.log_line(Status::Ok, Self::STEPS, || {
             format!(
                 "t = {t_end}: {} accepted ({} by Radau IIA), {} rejected steps, {} edges, {} rhs evaluations, {} Jacobians, {} LU in total; next step {:e} s by {method}",
                 stats.accepted,
@@ -289,23 +281,15 @@ impl Slave for Instance {
         model_identifier: contract::MODEL_IDENTIFIER,
         log_categories: LOG_CATEGORIES,
         state_magic: *b"GRFS",
-        state_version: 7,
+        state_version: 8,
         model_exchange: true,
         variable: contract::variable,
         variables: contract::VARIABLES,
         arrays: contract::FMI3_ARRAYS,
     };
 
-    fn interface(&self) -> Interface {
-        self.interface
-    }
-
-    fn log(&mut self) -> &mut Log {
-        &mut self.log
-    }
-
     fn check_decoded(&self, state: FmiState) -> FmiResult {
-        self.values.check(contract::VARIABLES)?;
+        self.core.values.check(contract::VARIABLES)?;
         if !self.tau_in_rate.is_finite() {
             return Err(FmiError::error(format!(
                 "dtau_in/dt is {}",
@@ -317,37 +301,9 @@ impl Slave for Instance {
             state,
             FmiState::StepComplete | FmiState::EventMode | FmiState::ContinuousTimeMode
         );
-        if running && self.sim.is_none() {
+        if running && self.core.sim.is_none() {
             return Err(FmiError::error("initialised, but without a simulation"));
         }
-        Ok(())
-    }
-
-    fn new(logging_on: bool, interface: Interface) -> Self {
-        Instance {
-            interface,
-            values: Values::start(contract::VARIABLES),
-            tau_in_rate: 0.0,
-            start_time: 0.0,
-            tolerance: None,
-            sim: None,
-            log: Log::new(LOG_CATEGORIES, logging_on),
-        }
-    }
-
-    fn setup_experiment(&mut self, tolerance: Option<f64>, start_time: f64) {
-        self.start_time = start_time;
-        self.tolerance = tolerance;
-    }
-
-    fn enter_initialization_mode(&mut self) {
-        self.sim = None;
-    }
-
-    /// Validates every parameter and builds the initial state; an invalid parameter is
-    /// refused and the instance stays in initialisation mode, where it can be corrected.
-    fn exit_initialization_mode(&mut self) -> FmiResult {
-        self.sim = Some(self.build()?);
         Ok(())
     }
 
@@ -355,9 +311,10 @@ impl Slave for Instance {
         for (vr, out) in vrs.iter().zip(out) {
             // An output of the running simulation first: what a master reads after each step.
             let output = self
+                .core
                 .sim
                 .as_ref()
-                .and_then(|sim| Self::output(sim, self.interface, *vr));
+                .and_then(|sim| Self::output(sim, self.core.interface, *vr));
             *out = match output {
                 Some(value) => value,
                 None => self.real_value(*vr)?,
@@ -373,9 +330,10 @@ impl Slave for Instance {
         if fmi2_shell::contract::computed(contract::variable, Kind::Integer, vrs) {
             self.current()?;
         }
-        let sim = self.sim.as_ref();
+        let sim = self.core.sim.as_ref();
         let output = |vr| sim?.integer_output(vr);
-        self.values
+        self.core
+            .values
             .get_integer(contract::variable, vrs, out, output)
     }
 
@@ -383,7 +341,7 @@ impl Slave for Instance {
     fn set_real(&mut self, state: FmiState, vrs: &[u32], values: &[f64]) -> FmiResult {
         let mut shaft_changed = false;
         for (vr, value) in vrs.iter().zip(values) {
-            self.values.set_real(*vr, *value);
+            self.core.values.set_real(*vr, *value);
             shaft_changed |= matches!(*vr, vr::theta_M | vr::omega_M | vr::alpha_M | vr::tau_in);
         }
         if shaft_changed || !state.is_initialised() {
@@ -393,26 +351,7 @@ impl Slave for Instance {
     }
 
     fn set_integer(&mut self, state: FmiState, vrs: &[u32], values: &[i32]) -> FmiResult {
-        for (vr, value) in vrs.iter().zip(values) {
-            self.values.set_integer(*vr, *value as i64);
-        }
-        if state == FmiState::InitializationMode {
-            self.sim = None;
-        }
-        Ok(())
-    }
-
-    /// One communication step from the master's point `current` (the shell has checked it
-    /// against the time); a failure leaves the state at `current`.
-    fn step(&mut self, current: f64, h: f64) -> FmiResult {
-        self.step_until(current, current + h, false).map(|_| ())
-    }
-
-    /// Early return (FMI 3.0): the step ends at the first impact inside it.
-    const STEPS_TO_EVENTS: bool = true;
-
-    fn step_to_event(&mut self, current: f64, t_end: f64) -> FmiResult<f64> {
-        self.step_until(current, t_end, true)
+        self.core.set_integer(state, vrs, values)
     }
 
     /// fmi2SetRealInputDerivatives: the derivatives of θ_M (orders 1, 2) and ω_M (order 1) at
@@ -450,7 +389,7 @@ impl Slave for Instance {
         }
         for (target, value) in targets {
             match target {
-                Some(vr) => self.values.set_real(vr, value),
+                Some(vr) => self.core.values.set_real(vr, value),
                 None => self.tau_in_rate = value,
             }
         }
@@ -487,7 +426,7 @@ impl Slave for Instance {
                 "dvKnown = {dv} refused: the seed vector must be finite"
             )));
         }
-        match self.interface {
+        match self.core.interface {
             Interface::CoSimulation => {
                 for k in knowns {
                     let var = contract::variable(Kind::Real, *k)?;
@@ -531,7 +470,7 @@ impl Slave for Instance {
     // Model Exchange (see `model_exchange`).
 
     fn set_time(&mut self, t: f64) -> FmiResult {
-        self.model_exchange().set_time(t).map_err(|shaft| {
+        self.core.running_mut().set_time(t).map_err(|shaft| {
             FmiError::error(format!(
                 "time = {t:e} refused: the main shaft's motion there is not finite ({shaft:?}), beyond what the model can represent"
             ))
@@ -539,18 +478,17 @@ impl Slave for Instance {
     }
 
     fn continuous(&mut self) -> FmiResult<&mut impl Continuous> {
-        self.current()?;
-        Ok(self.model_exchange())
+        self.current()
     }
 
     fn new_discrete_states(&mut self) -> FmiResult<EventInfo> {
-        let sim = self.model_exchange();
+        let sim = self.core.running_mut();
         let before = sim.impacts();
         let next_event_time = sim.update_discrete_states();
         let after = sim.impacts();
         if before != after {
             let t = sim.t;
-            self.log_line(Status::Ok, EVENTS, || {
+            self.log_line(Status::Ok, Self::EVENTS, || {
                 format!(
                     "t = {t}: impact at |xi'| = {:e} m/s ({} on F+, {} on F- so far)",
                     after.last_speed, after.count[0], after.count[1]
@@ -562,11 +500,6 @@ impl Slave for Instance {
             ..EventInfo::default()
         })
     }
-
-    fn completed_integrator_step(&mut self) -> FmiResult<bool> {
-        self.model_exchange().completed_integrator_step();
-        Ok(false)
-    }
 }
 
 #[cfg(test)]
@@ -574,6 +507,7 @@ mod tests {
     use super::*;
     use fmi2_shell::Fmu;
     use fmi2_shell::fmu_state::{deserialize, serialize};
+    use fmi2_shell::values::Values;
 
     fn stepped() -> Fmu<Instance> {
         let mut i = Fmu::<Instance>::new(false, Interface::CoSimulation);
@@ -601,22 +535,22 @@ mod tests {
         let refused =
             |i: &Fmu<Instance>| deserialize::<Instance>(&serialize(i)).unwrap_err().message;
         let mut no_sim = stepped();
-        no_sim.slave.sim = None;
+        no_sim.slave.core.sim = None;
         assert!(refused(&no_sim).contains("without a simulation"));
         let mut in_event_mode = Fmu::<Instance>::new(false, Interface::ModelExchange);
         in_event_mode.state = FmiState::EventMode;
         assert!(refused(&in_event_mode).contains("without a simulation"));
         let mut stepping = stepped();
-        stepping.slave.interface = Interface::ModelExchange;
+        stepping.slave.core.interface = Interface::ModelExchange;
         assert!(refused(&stepping).contains("ModelExchange instance in state StepComplete"));
         let mut integrating = stepped();
         integrating.state = FmiState::ContinuousTimeMode;
         assert!(refused(&integrating).contains("CoSimulation instance in state Continuous"));
         let mut nan = stepped();
-        nan.slave.values.set_real(vr::omega_M, f64::NAN);
+        nan.slave.core.values.set_real(vr::omega_M, f64::NAN);
         assert!(refused(&nan).contains("NaN"));
         let mut short = stepped();
-        short.slave.values = values_without_integers();
+        short.slave.core.values = values_without_integers();
         assert!(refused(&short).contains("Integer values"));
     }
 

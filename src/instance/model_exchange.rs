@@ -140,6 +140,12 @@ impl Continuous for Simulation {
     fn nominals(&self) -> [f64; NX] {
         nominals(self.now().dynamics.params.G)
     }
+
+    /// After an accepted step of the importer: |a| there for the statistics' peak.
+    fn completed_integrator_step(&mut self) {
+        let t = self.t;
+        on_gear!(&mut self.gear, k => k.sample_acceleration(t))
+    }
 }
 
 impl Simulation {
@@ -233,12 +239,6 @@ impl Simulation {
     pub fn update_discrete_states(&mut self) -> Option<f64> {
         let t = self.t;
         on_gear!(&mut self.gear, k => k.update_discrete_states(t))
-    }
-
-    /// After an accepted step of the importer: |a| there for the statistics' peak.
-    pub fn completed_integrator_step(&mut self) {
-        let t = self.t;
-        on_gear!(&mut self.gear, k => k.sample_acceleration(t))
     }
 
     /// A Real output as Model Exchange reads it: the contact's loads, and the torque mode's

@@ -6,7 +6,7 @@
 use crate::contract::{self, Causality, Kind, LOG_CATEGORIES, VARIABLES, vr};
 use crate::model::{Params, State};
 use fmi2_shell::values::Values;
-use fmi2_shell::{FmiError, FmiResult, FmiState, Identity, Interface, Log, Slave};
+use fmi2_shell::{FmiError, FmiResult, FmiState, Identity, Interface, Lifecycle, Log, Slave};
 use serde::{Deserialize, Serialize};
 
 /// The model's part of what determines the future of an instance (what fmi2GetFMUstate
@@ -50,19 +50,9 @@ impl Instance {
     }
 }
 
-impl Slave for Instance {
-    const IDENTITY: Identity = Identity {
-        guid: contract::GUID,
-        model_identifier: contract::MODEL_IDENTIFIER,
-        log_categories: LOG_CATEGORIES,
-        state_magic: *b"FLYS",
-        state_version: 3,
-        model_exchange: false,
-        variable: contract::variable,
-        variables: contract::VARIABLES,
-        arrays: contract::FMI3_ARRAYS,
-    };
-
+/// The flywheel's simulation is its parameters and state, without a solver or a tolerance:
+/// it makes, initialises and steps itself.
+impl Lifecycle for Instance {
     fn new(logging_on: bool, _interface: Interface) -> Self {
         Instance {
             y: [0.0; 4],
@@ -85,6 +75,37 @@ impl Slave for Instance {
         Ok(())
     }
 
+    /// One step of h from `current` (the shell has checked both).
+    fn step(&mut self, current: f64, h: f64) -> FmiResult {
+        let p = self.params.expect("initialised");
+        let tau = self.tau_M();
+        let y = p.advance(&self.y, tau, self.tau_dot, h);
+        if y.iter().any(|x| !x.is_finite()) {
+            return Err(error(format!(
+                "the state is no longer finite at t = {}",
+                current + h
+            )));
+        }
+        self.y = y;
+        // The input follows its ramp until the master sets it again.
+        self.values.set_real(vr::tau_M, tau + self.tau_dot * h);
+        Ok(())
+    }
+}
+
+impl Slave for Instance {
+    const IDENTITY: Identity = Identity {
+        guid: contract::GUID,
+        model_identifier: contract::MODEL_IDENTIFIER,
+        log_categories: LOG_CATEGORIES,
+        state_magic: *b"FLYS",
+        state_version: 3,
+        model_exchange: false,
+        variable: contract::variable,
+        variables: contract::VARIABLES,
+        arrays: contract::FMI3_ARRAYS,
+    };
+
     fn get_real(&mut self, vrs: &[u32], out: &mut [f64]) -> FmiResult {
         for (vr, out) in vrs.iter().zip(out.iter_mut()) {
             *out = match contract::variable(Kind::Real, *vr)?.causality {
@@ -105,23 +126,6 @@ impl Slave for Instance {
         for (vr, value) in vrs.iter().zip(values) {
             self.values.set_real(*vr, *value);
         }
-        Ok(())
-    }
-
-    /// One step of h from `current` (the shell has checked both).
-    fn step(&mut self, current: f64, h: f64) -> FmiResult {
-        let p = self.params.expect("initialised");
-        let tau = self.tau_M();
-        let y = p.advance(&self.y, tau, self.tau_dot, h);
-        if y.iter().any(|x| !x.is_finite()) {
-            return Err(error(format!(
-                "the state is no longer finite at t = {}",
-                current + h
-            )));
-        }
-        self.y = y;
-        // The input follows its ramp until the master sets it again.
-        self.values.set_real(vr::tau_M, tau + self.tau_dot * h);
         Ok(())
     }
 
