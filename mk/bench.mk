@@ -9,6 +9,9 @@
 
 BENCH_DIR := target/bench
 BENCH_REF := $(BENCH_DIR)/reference/scenes.csv
+# The benchmark's Python modules (benches/precision) stay out of the installed package: its
+# command lines run with benches/ on the import path.
+BENCH_PY := PYTHONPATH=benches$${PYTHONPATH:+:$$PYTHONPATH} $(PY)
 
 .PHONY: bench bench-reference bench-profile bench-overhead
 
@@ -19,11 +22,11 @@ bench: fmu $(VENV)/.installed $(BENCH_REF) | libclang
 	{ echo "Load average at the start: $$(cut -d' ' -f1-3 /proc/loadavg) (1, 5, 15 min)."; } > $(BENCH_DIR)/machine.txt; \
 	set -e; \
 	cargo bench -p gear_rattle_bench --bench work_precision; \
-	$(PY) scripts/bench_python.py; \
+	$(BENCH_PY) scripts/bench_python.py; \
 	tol=$$($(PY) -c "import csv; r=[x for x in csv.DictReader(open('$(BENCH_DIR)/rust.csv')) if x['solver']=='GearRattle (direct)' and x['scene']=='S1-1s' and x['status']=='ok' and float(x['err_max_xi'])<=1e-9]; print(max((float(x['rtol']) for x in r), default=1e-9))"); \
 	$(MAKE) --no-print-directory bench-profile BENCH_PROFILE_RTOL=$$tol; \
 	echo "Load average at the end: $$(cut -d' ' -f1-3 /proc/loadavg) (1, 5, 15 min)." >> $(BENCH_DIR)/machine.txt; \
-	$(PY) scripts/bench_report.py --started $$started
+	$(BENCH_PY) scripts/bench_report.py --started $$started
 
 ## bench-profile: GearRattle alone on S1 under perf -> target/bench/profile.txt, the cost of a call -> calls.txt (part of bench)
 # The bench binary is built first and recorded alone, so that no compiler shows in the profile.
