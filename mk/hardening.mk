@@ -35,9 +35,12 @@ fuzz-tools: nightly
 		cargo +nightly install cargo-fuzz --version $(CARGO_FUZZ_VERSION) --locked -j 2; }
 
 ## fuzz: libFuzzer + ASan over random fmi2 call sequences (FUZZ_SECONDS=60); a crash fails
+# Nightly cargo warns when MAKEFLAGS names a jobserver its recipe cannot reach (under make
+# test's -j2); a recipe marked + would reach it but lose --output-sync=target's grouping, so
+# the fuzzer's cargo is not told of it and keeps its own two jobs.
 fuzz: fuzz-tools | libclang
 	mkdir -p $(FUZZ_SCRATCH)
-	cd fuzz && CARGO_BUILD_JOBS=2 cargo +nightly fuzz run $(FUZZ_TARGET) \
+	cd fuzz && MAKEFLAGS= CARGO_BUILD_JOBS=2 cargo +nightly fuzz run $(FUZZ_TARGET) \
 		../$(FUZZ_SCRATCH) corpus/$(FUZZ_TARGET) -- $(FUZZ_FLAGS) 2>&1 \
 		| grep -v -e '^#' -e '^\s*NEW_FUNC' -e '^INFO: ' -e '^"' -e 'callback_log' ; exit $${PIPESTATUS[0]}
 
