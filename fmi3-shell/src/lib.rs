@@ -11,7 +11,7 @@
 //!   ([`fmi2_shell::contract::fmi3`]), the time and event indicators as variables,
 //!   Enumerations as Int64, the adjoint derivatives from the directional ones, the
 //!   instantiation of each interface, Co-Simulation's early return at the model's events
-//!   ([`Slave::step_to_event`]), its event mode and its intermediate update at each of
+//!   ([`Lifecycle::step_to_event`]), its event mode and its intermediate update at each of
 //!   those events, as the importer allows and asks for them;
 //! - a contract's arrays as FMI 3.0's array variables sized by structural parameters, set in
 //!   configuration mode ([`arrays`]);
@@ -20,7 +20,7 @@
 //! Not offered: intermediate variables, clocks, scheduled execution, and configuration mode for
 //! a model without structural parameters; their functions refuse with a log line.
 //!
-//! [`Slave::step_to_event`]: fmi2_shell::Lifecycle::step_to_event
+//! [`Lifecycle::step_to_event`]: fmi2_shell::Lifecycle::step_to_event
 //!
 //! [`Slave`]: fmi2_shell::Slave
 //! [`Fmu`]: fmi2_shell::Fmu
