@@ -50,8 +50,8 @@ bench-profile: | libclang
 ## bench-reference: the independent reference solutions of the benchmark scenes
 bench-reference: $(BENCH_REF)
 
-$(BENCH_REF): scripts/bench_reference.py | $(VENV)/.installed
-	$(PY) scripts/bench_reference.py --out $(BENCH_DIR)/reference
+$(BENCH_REF): scripts/bench_reference.py benches/precision/reference.py | $(VENV)/.installed
+	$(BENCH_PY) scripts/bench_reference.py --out $(BENCH_DIR)/reference
 
 ## bench-overhead: the statistics' cost on S1 against the FMU library of OVERHEAD_BASE, from C (prints)
 # The base commit is checked out in a worktree under target/ and built there (its own target/,

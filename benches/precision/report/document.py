@@ -274,7 +274,7 @@ def write(bench: pathlib.Path, out: pathlib.Path, png: pathlib.Path, started: fl
         w(f"- Wall time of this `make bench`: {wall / 60:.1f} min.")
     w("- Commands (one does all): `make bench`, which runs")
     w("  1. `make fmu` (target/fmu/GearRattle.fmu);")
-    w("  2. `.venv/bin/python scripts/bench_reference.py` (only when it or python/gearrattle/reference.py changed: "
+    w("  2. `PYTHONPATH=benches .venv/bin/python scripts/bench_reference.py` (only when it or python/gearrattle/reference.py changed: "
       "target/bench/reference/; about 8 minutes more, mostly the Radau checks);")
     w("  3. `cargo bench -p gear_rattle_bench --bench work_precision` (target/bench/rust.csv; `BENCH_QUICK=1` for a smoke run, "
       "`BENCH_SCENES=S1-1s,...` for a subset);")
