@@ -143,7 +143,7 @@ struct Reference {
 fn read_csv(path: &Path) -> Vec<std::collections::HashMap<String, String>> {
     let text = std::fs::read_to_string(path).unwrap_or_else(|e| {
         panic!(
-            "{}: {e}; run `.venv/bin/python scripts/bench_python.py reference` first (or `make bench`)",
+            "{}: {e}; run `make bench-reference` first (or `make bench`)",
             path.display()
         )
     });
