@@ -113,8 +113,8 @@ impl Independent {
         t_end: f64,
         at_impact: bool,
     ) -> Result<bool, SolverError> {
-        let before = self.clone();
-        match self.advance_all(*t, t_end, at_impact) {
+        let starts = self.pairs.clone();
+        match self.advance_all(&starts, *t, t_end, at_impact) {
             Ok((reached, stopped)) => {
                 self.add_input_drag(*t, reached);
                 self.mirror();
@@ -122,22 +122,22 @@ impl Independent {
                 Ok(stopped)
             }
             Err(e) => {
-                *self = before;
+                self.pairs = starts;
                 Err(e)
             }
         }
     }
 
-    /// Each pair in turn to the earliest stop so far; a pair that stops earlier takes the
-    /// pairs before it back to its stop (none of them had an impact before it). Returns the
-    /// time all reached and whether it is an impact's.
+    /// Each pair in turn from `starts` at t0 to the earliest stop so far; a pair that stops
+    /// earlier takes the pairs before it back to its stop (none of them had an impact before
+    /// it). Returns the time all reached and whether it is an impact's.
     fn advance_all(
         &mut self,
+        starts: &[Pair],
         t0: f64,
         t_end: f64,
         at_impact: bool,
     ) -> Result<(f64, bool), SolverError> {
-        let starts = self.pairs.clone();
         let (mut stop, mut stopped) = (t_end, false);
         for i in 0..self.pairs.len() {
             let mut t = t0;
@@ -145,7 +145,7 @@ impl Independent {
                 continue;
             }
             if t < stop {
-                for (k, start) in self.pairs[..i].iter_mut().zip(&starts) {
+                for (k, start) in self.pairs[..i].iter_mut().zip(starts) {
                     let mut back = t0;
                     *k = *start;
                     k.advance(&mut back, t, false)?;

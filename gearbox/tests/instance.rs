@@ -127,7 +127,8 @@ fn saved_states_replay_bit_exactly() {
 /// The input side imposed (excitation 2), its motion a 27 Hz oscillation about 84 rad/s, new
 /// every millisecond: the gears step apart. Steps that stop at the first impact of any gear
 /// stop at one impact each (one gear's count up by one), and together count the impacts of
-/// the plain run, gear by gear, and end where it does within the tolerance.
+/// the plain run, gear by gear, and end where it does within the tolerance. A step that fails
+/// leaves the simulation as it was.
 #[test]
 fn gears_stepped_apart_stop_at_each_impact() {
     use gear_rattle::physics::Shaft;
@@ -176,6 +177,11 @@ fn gears_stepped_apart_stop_at_each_impact() {
         }
         assert_eq!(counts(&stopping), counts(&plain));
         assert!(stops > 20, "{stops} impacts");
+        // A step below the resolution of time fails and leaves every gear as it was.
+        let before = plain.clone();
+        let t = plain.t;
+        assert!(plain.step_until(t + 4.0 * f64::EPSILON * t, false).is_err());
+        assert!(plain == before);
         let (g, y) = (plain.gearbox(), stopping.gearbox().1);
         for i in 0..3 {
             let k = gear_rattle::gearbox::xi(i);
