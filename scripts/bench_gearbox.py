@@ -16,7 +16,7 @@ from gearrattle import gearbox_bench as B
 from gearrattle import gearbox_fmu as GF
 from gearrattle.study.cli import main as study
 
-DOC = B.GF.ROOT / "docs" / "docs/GEARBOX.md"
+DOC = B.GF.ROOT / "docs" / "GEARBOX.md"
 PLOT = B.GF.ROOT / "docs" / "gearbox_cost.png"
 BEGIN, END = "<!-- bench-gearbox:begin -->", "<!-- bench-gearbox:end -->"
 

@@ -5,12 +5,14 @@
 //! - [`contract`]: value references and the model description, generated from
 //!   `modelDescription/GearboxRattle.toml`;
 //! - [`windowed`]: the gearbox with the statistics window's quadratures per gear;
+//! - [`independent`]: the gears stepped apart on an imposed input side;
 //! - [`simulation`]: the running model (parameters, drive, stepping with rollback);
 //! - [`outputs`]: every output of the contract, computed when read;
 //! - [`model_exchange`]: the states, derivatives and event indicators of Model Exchange;
 //! - [`instance`]: the slave of fmi2-shell and fmi3-shell.
 
 pub mod contract;
+pub mod independent;
 pub mod instance;
 pub mod model_exchange;
 pub mod outputs;

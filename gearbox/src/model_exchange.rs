@@ -195,6 +195,7 @@ impl Simulation {
         match &mut self.run {
             Run::Lean(k) => settle_past(&mut k.system, t, &k.y),
             Run::Windowed(k) => settle_past(&mut k.system, t, &k.y),
+            Run::Independent(_) => unreachable!("Model Exchange steps the coupled box"),
         }
         if self.window_from <= self.t {
             self.open_window();

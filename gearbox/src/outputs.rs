@@ -6,7 +6,6 @@
 use crate::contract::vr::{self, gear::offset};
 use crate::contract::{DERIVATIVES, STATES};
 use crate::simulation::Simulation;
-use crate::windowed;
 use fmi2_shell::Continuous;
 use gear_rattle::gearbox::{Gearbox, Readout};
 use gear_rattle::rattle::window::Metrics;
@@ -62,10 +61,9 @@ impl<'a> Now<'a> {
 
     /// Gear i's window figures (zero before the window opens).
     fn metrics(&self, i: usize) -> Option<Metrics> {
-        let (windows, w) = self.sim.windows().filter(|_| i < self.gearbox.n_gears())?;
+        let (window, q) = self.sim.window(i).filter(|_| i < self.gearbox.n_gears())?;
         let p = &self.gearbox.gears[i].dynamics.params;
-        let q = windowed::quadratures(w, i);
-        Some(windows[i].metrics(self.sim.t, &q, p.I_L / (p.r_L * p.r_L)))
+        Some(window.metrics(self.sim.t, &q, p.I_L / (p.r_L * p.r_L)))
     }
 
     /// Gear i's rattle power over the window: its impact energy per second.

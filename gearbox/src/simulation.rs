@@ -6,6 +6,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::contract::{self, vr};
+use crate::independent::Independent;
 use crate::windowed::{self, Windowed};
 use fmi2_shell::values::Values;
 use fmi2_shell::{FmiError, FmiResult};
@@ -15,20 +16,22 @@ use gear_rattle::integrator::{Method, Solver, SolverError, Stats};
 use gear_rattle::physics::{
     DamperParams, Engine, EngineOrder, EngineParams, GearParams, Oil, Polynomial, Shaft,
 };
-use gear_rattle::rattle::window::Window;
+use gear_rattle::rattle::window::{Quadratures, Window};
 
 /// Values of the `excitation` parameter.
 pub const EXCITATION_FLYWHEEL: i64 = 0;
 pub const EXCITATION_ENGINE: i64 = 1;
 pub const EXCITATION_INPUT_SIDE: i64 = 2;
 
-/// The gearbox before its statistics window opens, and with it. Boxed: their solvers are
-/// some 60 and 145 KB, which an instance, its FMU states and their decoding keep off the
-/// stack (an importer's thread may have 1 MB).
+/// The gearbox before its statistics window opens, and with it; or on an imposed input side
+/// in co-simulation, its gears stepped apart. Boxed: their solvers are some 60 and 145 KB,
+/// which an instance, its FMU states and their decoding keep off the stack (an importer's
+/// thread may have 1 MB).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub enum Run {
     Lean(Box<Stepped<Gearbox, { gearbox::N }>>),
     Windowed(Box<Stepped<Windowed, { windowed::N }>>),
+    Independent(Box<Independent>),
 }
 
 /// An initialised gearbox being stepped.
@@ -148,12 +151,13 @@ fn impacts(g: &Gearbox) -> u64 {
         .sum()
 }
 
-/// `$body` with `$k` the stepped system of `$run`, whichever it is.
+/// `$body` with `$k` the stepped system of `$run`, or `$independent` with `$p` its gears.
 macro_rules! on_run {
-    ($run:expr, $k:ident => $body:expr) => {
+    ($run:expr, $k:ident => $body:expr, $p:ident => $independent:expr) => {
         match $run {
             Run::Lean($k) => $body,
             Run::Windowed($k) => $body,
+            Run::Independent($p) => $independent,
         }
     };
 }
@@ -177,13 +181,26 @@ impl Simulation {
         let mut system = Gearbox::new(&params, drive, &y);
         system.set_output_speed(values.real(vr::omega_out));
         let method = method(values.integer(vr::solver));
+        let window_from = values.real(vr::stats_from).max(t0);
+        if matches!(drive, Drive::InputSide(_)) && !model_exchange {
+            let run = Independent::new(system, &y, t0, window_from, rtol, method);
+            return Ok(Simulation {
+                run: Run::Independent(Box::new(run)),
+                t: t0,
+                window_from,
+                rtol,
+                method,
+                interpolate_ends: false,
+                model_exchange,
+            });
+        }
         let interpolate_ends = matches!(drive, Drive::Engine(_));
         let mut solver = Solver::with_method(system.tolerance(rtol), method);
         solver.interpolate_ends = interpolate_ends;
         let mut sim = Simulation {
             run: Run::Lean(Box::new(Stepped { system, solver, y })),
             t: t0,
-            window_from: values.real(vr::stats_from).max(t0),
+            window_from,
             rtol,
             method,
             interpolate_ends,
@@ -240,6 +257,7 @@ impl Simulation {
         match &mut self.run {
             Run::Lean(k) => k.advance_until(&mut self.t, t_end, |g| on * impacts(g)),
             Run::Windowed(k) => k.advance_until(&mut self.t, t_end, |w| on * impacts(&w.inner)),
+            Run::Independent(p) => p.advance(&mut self.t, t_end, at_impact),
         }
     }
 
@@ -258,14 +276,16 @@ impl Simulation {
         match &self.run {
             Run::Lean(k) => (&k.system, k.y),
             Run::Windowed(k) => (&k.system.inner, windowed::head(&k.y)),
+            Run::Independent(p) => (&p.gearbox, p.state()),
         }
     }
 
-    /// Each gear's statistics window and its quadratures, once it is open.
-    pub fn windows(&self) -> Option<(&[Window; gearbox::MAX_GEARS], &[f64; windowed::N])> {
+    /// Gear i's statistics window and its quadratures, once it is open.
+    pub fn window(&self, i: usize) -> Option<(&Window, Quadratures)> {
         match &self.run {
             Run::Lean(_) => None,
-            Run::Windowed(k) => Some((&k.system.windows, &k.y)),
+            Run::Windowed(k) => Some((&k.system.windows[i], windowed::quadratures(&k.y, i))),
+            Run::Independent(p) => p.window(i),
         }
     }
 
@@ -284,6 +304,9 @@ impl Simulation {
                 k.y[..gearbox::N].copy_from_slice(&y);
                 k.solver.invalidate();
             }
+            Run::Independent(_) => {
+                unreachable!("the gears stepped apart change through their own setters")
+            }
         }
     }
 
@@ -298,7 +321,9 @@ impl Simulation {
 
     /// New input-side inputs (excitation 2; ignored otherwise): the ξ_i follow at once.
     pub fn set_input_side(&mut self, shaft: Shaft) {
-        if matches!(self.gearbox().0.drive, Drive::InputSide(_)) {
+        if let Run::Independent(p) = &mut self.run {
+            p.set_input_side(self.t, shaft);
+        } else if matches!(self.gearbox().0.drive, Drive::InputSide(_)) {
             self.change_state(|g, t, y| {
                 g.set_input_side(t, y, shaft);
             });
@@ -307,7 +332,11 @@ impl Simulation {
 
     /// The output shaft's speed.
     pub fn set_output_speed(&mut self, omega_out: f64) {
-        self.change_state(|g, _, _| g.set_output_speed(omega_out));
+        if let Run::Independent(p) = &mut self.run {
+            p.set_output_speed(omega_out);
+        } else {
+            self.change_state(|g, _, _| g.set_output_speed(omega_out));
+        }
     }
 
     /// The imposed motion's extrapolation now (excitation 0: the flywheel's, 2: the input
@@ -321,14 +350,14 @@ impl Simulation {
     }
 
     pub fn stats(&self) -> Stats {
-        on_run!(&self.run, k => k.solver.stats)
+        on_run!(&self.run, k => k.solver.stats, p => p.stats())
     }
 
     pub fn is_implicit(&self) -> bool {
-        on_run!(&self.run, k => k.solver.is_implicit())
+        on_run!(&self.run, k => k.solver.is_implicit(), p => p.is_implicit())
     }
 
     pub fn proposed_step(&self) -> f64 {
-        on_run!(&self.run, k => k.solver.proposed_step())
+        on_run!(&self.run, k => k.solver.proposed_step(), p => p.proposed_step())
     }
 }

@@ -99,20 +99,100 @@ fn every_output_is_computed() {
 }
 
 /// A state saved (and serialized) in the window's first part replays the next steps to the
-/// last bit, across the window's opening too.
+/// last bit, across the window's opening too: the coupled box (the engine) and the gears
+/// stepped apart (the input side imposed).
 #[test]
 fn saved_states_replay_bit_exactly() {
     with_stack(|| {
-        let mut i = initialised(&[(vr::stats_from, 0.03)]);
-        run(&mut i, 0.0, 0.02, 1e-3);
-        let saved: Fmu<Instance> = deserialize(&serialize(&i)).unwrap();
-        run(&mut i, 0.02, 0.06, 1e-3);
-        let first = serialize(&i);
-        let mut j = Fmu::<Instance>::new(false, Interface::CoSimulation);
-        j.restore(&saved).unwrap();
-        run(&mut j, 0.02, 0.06, 1e-3);
-        assert_eq!(serialize(&j), first);
-        assert!(real(&mut j, vr::gear::stat_window[0]) > 0.0);
+        for excitation in [1, 2] {
+            let mut i = Fmu::<Instance>::new(false, Interface::CoSimulation);
+            i.enter_initialization_mode().unwrap();
+            i.set_integer(&[vr::excitation], &[excitation]).unwrap();
+            i.set_real(&[vr::stats_from, vr::omega_I], &[0.0305, 84.0])
+                .unwrap();
+            i.exit_initialization_mode().unwrap();
+            run(&mut i, 0.0, 0.02, 1e-3);
+            let saved: Fmu<Instance> = deserialize(&serialize(&i)).unwrap();
+            run(&mut i, 0.02, 0.06, 1e-3);
+            let first = serialize(&i);
+            let mut j = Fmu::<Instance>::new(false, Interface::CoSimulation);
+            j.restore(&saved).unwrap();
+            run(&mut j, 0.02, 0.06, 1e-3);
+            assert_eq!(serialize(&j), first, "excitation {excitation}");
+            assert!(real(&mut j, vr::gear::stat_window[0]) > 0.0);
+        }
+    });
+}
+
+/// The input side imposed (excitation 2), its motion a 27 Hz oscillation about 84 rad/s, new
+/// every millisecond: the gears step apart. Steps that stop at the first impact of any gear
+/// stop at one impact each (one gear's count up by one), and together count the impacts of
+/// the plain run, gear by gear, and end where it does within the tolerance. A step that fails
+/// leaves the simulation as it was.
+#[test]
+fn gears_stepped_apart_stop_at_each_impact() {
+    use gear_rattle::physics::Shaft;
+    use gearbox_rattle::simulation::{Run, Simulation};
+    with_stack(|| {
+        let mut values = fmi2_shell::values::Values::start(VARIABLES);
+        values.set_integer(vr::excitation, 2);
+        values.set_integer(vr::n_gears, 3);
+        values.set_real(vr::omega_I, 84.0);
+        let start = Simulation::new(&values, 0.0, 1e-8, false).unwrap();
+        assert!(matches!(start.run, Run::Independent(_)));
+        let w = 2.0 * std::f64::consts::PI * 26.7;
+        let a = 600.0 / (w * w);
+        let shaft = |t: f64| Shaft {
+            theta: 84.0 * t + a * (w * t).sin(),
+            omega: 84.0 + a * w * (w * t).cos(),
+            alpha: -600.0 * (w * t).sin(),
+        };
+        let counts = |s: &Simulation| {
+            s.gearbox()
+                .0
+                .gears
+                .map(|g| g.impacts.count[0] + g.impacts.count[1])
+        };
+        let (mut plain, mut stopping) = (start.clone(), start);
+        let mut stops = 0;
+        for k in 0..100 {
+            let (t, t_end) = (k as f64 * 1e-3, (k + 1) as f64 * 1e-3);
+            plain.set_input_side(shaft(t));
+            plain.step_until(t_end, false).unwrap();
+            stopping.set_input_side(shaft(t));
+            loop {
+                let before = counts(&stopping);
+                let reached = stopping.step_until(t_end, true).unwrap();
+                let after = counts(&stopping);
+                let new: u64 = after.iter().zip(&before).map(|(a, b)| a - b).sum();
+                if reached < t_end {
+                    assert_eq!(new, 1, "at {reached}");
+                    stops += 1;
+                } else {
+                    assert!(new <= 1, "at {reached}");
+                    stops += new;
+                    break;
+                }
+            }
+        }
+        assert_eq!(counts(&stopping), counts(&plain));
+        assert!(stops > 20, "{stops} impacts");
+        // A step below the resolution of time fails and leaves every gear as it was.
+        let before = plain.clone();
+        let t = plain.t;
+        assert!(plain.step_until(t + 4.0 * f64::EPSILON * t, false).is_err());
+        assert!(plain == before);
+        let (g, y) = (plain.gearbox(), stopping.gearbox().1);
+        for i in 0..3 {
+            let k = gear_rattle::gearbox::xi(i);
+            let gap = g.0.gears[i].dynamics.params.G;
+            assert!(
+                (g.1[k] - y[k]).abs() < 1e-6 * gap,
+                "gear {i}: {} {}",
+                g.1[k],
+                y[k]
+            );
+        }
     });
 }
 

@@ -85,7 +85,12 @@ impl<S: GearPair<N> + Jacobian<N> + Copy, const N: usize> Stepped<S, N> {
     /// quadratures are kept. With `at_impact`, stops at the first impact (contact onset) on
     /// the way, as located: true if it did. A failure leaves the pair where it failed (the
     /// simulation's [`Journal`] puts it back).
-    fn advance(&mut self, t: &mut f64, t_end: f64, at_impact: bool) -> Result<bool, SolverError> {
+    pub fn advance(
+        &mut self,
+        t: &mut f64,
+        t_end: f64,
+        at_impact: bool,
+    ) -> Result<bool, SolverError> {
         let impacts = move |s: &S| {
             let count = s.impacts().count;
             if at_impact { count[0] + count[1] } else { 0 }
@@ -156,9 +161,21 @@ impl<S: GearPair<N> + Jacobian<N> + Copy, const N: usize> Stepped<S, N> {
 }
 
 impl<const N: usize> Stepped<KinematicRattle<N>, N> {
+    /// New motion of the main shaft at t, from `old` to `shaft`, imposed from then on as
+    /// `excitation`. The loose gear does not move, so ξ and ξ' follow the shaft
+    /// (ξ = r_L θ_L − r_M θ_M) and the region settles where ξ lands; the solver starts afresh.
+    pub fn move_shaft(&mut self, t: f64, old: Shaft, shaft: Shaft, excitation: Excitation) {
+        let r_M = self.system.dynamics.params.r_M;
+        self.y[rattle::XI] += r_M * (old.theta - shaft.theta);
+        self.y[rattle::XI_DOT] += r_M * (old.omega - shaft.omega);
+        self.system.excitation = excitation;
+        self.system.settle(t, &self.y);
+        self.solver.invalidate();
+    }
+
     /// A kinematic pair at t0 (see [`Stepped::start`]) with its solver at `rtol`; `ends`:
     /// the end times of the calls are served from the dense output of natural steps.
-    fn kinematic(
+    pub fn kinematic(
         system: KinematicRattle<N>,
         rtol: f64,
         method: Method,
@@ -439,14 +456,8 @@ impl Simulation {
         };
         self.drive = Drive::Inputs(shaft);
         let (t, excitation) = (self.t, Self::excitation_from(self.drive, self.t));
-        by_coupling!(&mut self.gear, kinematic k => {
-            let r_M = k.system.dynamics.params.r_M;
-            k.y[rattle::XI] += r_M * (old.theta - shaft.theta);
-            k.y[rattle::XI_DOT] += r_M * (old.omega - shaft.omega);
-            k.system.excitation = excitation;
-            k.system.settle(t, &k.y);
-            k.solver.invalidate();
-        }, torque _ => {})
+        by_coupling!(&mut self.gear, kinematic k => k.move_shaft(t, old, shaft, excitation),
+            torque _ => {})
     }
 
     /// New torque on the main shaft and its rate (torque mode; ignored otherwise). The state

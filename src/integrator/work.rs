@@ -28,6 +28,22 @@ pub struct Stats {
     pub series_steps: u64,
 }
 
+impl std::ops::AddAssign for Stats {
+    /// The work of two solvers together.
+    fn add_assign(&mut self, o: Stats) {
+        self.rhs_evals += o.rhs_evals;
+        self.accepted += o.accepted;
+        self.rejected += o.rejected;
+        self.edges += o.edges;
+        self.implicit_steps += o.implicit_steps;
+        self.jacobians += o.jacobians;
+        self.decompositions += o.decompositions;
+        self.switches += o.switches;
+        self.exact_evals += o.exact_evals;
+        self.series_steps += o.series_steps;
+    }
+}
+
 /// Why the solver stopped short of the end time. The state is left at the last good point.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum SolverError {
