@@ -11,14 +11,16 @@ a lightly damped housing mode seen through its surface velocity. p is the sum ov
 modes of each H_ik applied to F_i.
 
 Each mode is discretised exactly for a force that is linear between its samples (first-order
-hold, FOH): the recursion reproduces the continuous response to the piecewise-linear force at
-every sample, so the only error is the force's deviation from its linear interpolant,
+hold, FOH), as one complex first-order recursion (the mode's pole), run at the WAV's rate on
+the force samples of each WAV interval: it reproduces the continuous response to the
+piecewise-linear force at every kept sample, so the only error is the force's deviation from
+its linear interpolant,
 |F − F_lin| ≤ h²/8 · max|F''|, filtered by the mode (docs/SOUND.md, "Error")."""
 
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.signal import cont2discrete, lfilter, lfilter_zi, ss2tf
+from scipy.signal import lfilter
 
 
 @dataclass(frozen=True)
@@ -51,17 +53,26 @@ DEFAULT_MODES = (
 )
 
 
-def foh_coefficients(mode, h):
-    """(b, a) of the FOH recursion of a mode with unit gain at the sample interval h [s]:
-    p[n] = b0 F[n] + b1 F[n−1] + b2 F[n−2] − a1 p[n−1] − a2 p[n−2]."""
+def foh_recursion(mode, h, decimate=1):
+    """The FOH recursion of a mode with unit gain at the sample interval h [s], kept at every
+    `decimate`-th sample: the mode's complex state x (x' = s1 x + F, p = 2 Re(r x)) obeys
+
+        x[n + D] = lam x[n] + sum_j c[j] F[n + j],   j = 0 .. D,   lam = exp(s1 h D)
+
+    exactly for a force linear between its samples. Returns (lam, c, r, s1)."""
+    s1 = mode.poles()[0]
     w = 2 * np.pi * mode.f
-    A = np.array([[0.0, 1.0], [-w * w, -2 * mode.zeta * w]])
-    B = np.array([[0.0], [1.0]])
-    C = np.array([[0.0, 2 * mode.zeta * w]])
-    D = np.array([[0.0]])
-    Ad, Bd, Cd, Dd, _ = cont2discrete((A, B, C, D), h, method="foh")
-    b, a = ss2tf(Ad, Bd, Cd, Dd)
-    return np.ravel(b), np.ravel(a)
+    r = 2 * mode.zeta * w * s1 / (s1 - np.conj(s1))
+    e = np.exp(s1 * h)
+    # one interval: x[n+1] = e x[n] + b0 F[n] + b1 F[n+1] (F linear in between)
+    b0 = e / s1 - (e - 1) / (s1 * s1 * h)
+    b1 = -1 / s1 + (e - 1) / (s1 * s1 * h)
+    D = decimate
+    c = np.zeros(D + 1, dtype=complex)
+    for j in range(D):
+        c[j] += e ** (D - 1 - j) * b0
+        c[j + 1] += e ** (D - 1 - j) * b1
+    return e ** D, c, r, s1
 
 
 class ModalTransfer:
@@ -79,24 +90,35 @@ class ModalTransfer:
                 raise ValueError(f"the mode at {m.f:g} Hz has {len(m.gains)} gains for "
                                  f"{n_meshes} meshes: give one gain (all meshes) or one per mesh")
 
-    def pressure(self, force, mesh, h):
+    def pressure(self, force, mesh, h, decimate=1):
         """The pressure [Pa] of one mesh's force samples F[n] = F(n h), the force before F[0]
         held at F[0]: the housing starts deflected by it and silent (H(0) = 0), as when a
-        recording starts while a gear rests on its flank."""
+        recording starts while a gear rests on its flank. Kept at every `decimate`-th sample
+        (F[0], F[D], ...), each mode run at that rate on the D + 1 force samples of each of its
+        intervals: one recursion over the kept samples instead of D."""
         force = np.asarray(force, dtype=float)
-        p = np.zeros_like(force)
+        D = decimate
+        M = (len(force) - 1) // D  # intervals of D samples
+        p = np.zeros(M + 1)
+        # (M, D + 1): row m holds F[m D] .. F[m D + D]
+        blocks = np.lib.stride_tricks.sliding_window_view(force[:M * D + 1], D + 1)[::D]
         for m in self.modes:
             g = m.gain(mesh)
-            if g:
-                b, a = foh_coefficients(m, h)
-                p += g * lfilter(b, a, force, zi=lfilter_zi(b, a) * force[:1])[0]
+            if not g:
+                continue
+            lam, c, r, s1 = foh_recursion(m, h, D)
+            u = blocks @ c.real + 1j * (blocks @ c.imag)
+            x0 = -force[0] / s1  # the state under the constant force F[0]
+            x = lfilter([1.0], [1.0, -lam], u, zi=[lam * x0])[0]
+            p[0] += 2 * g * (r * x0).real
+            p[1:] += 2 * g * (r * x).real
         return p
 
     def render(self, force, mesh, subsample):
         """The pressure at the WAV's instants (every subsample-th force sample)."""
         from .metrics import FS
 
-        return self.pressure(force, mesh, 1.0 / (FS * subsample))[::subsample]
+        return self.pressure(force, mesh, 1.0 / (FS * subsample), subsample)
 
     def describe(self):
         return "modal housing: " + ", ".join(
