@@ -32,7 +32,9 @@ impl<S: Slave> Fmu<S> {
         for j in 0..n {
             let t = current + j as f64 * dt;
             self.step_with(t, dt, |s| s.step(t, dt).map(|()| t + dt))?;
-            if let Err(e) = self.slave.get_real(vrs, &mut out[j * m..(j + 1) * m]) {
+            if m > 0
+                && let Err(e) = self.slave.get_real(vrs, &mut out[j * m..(j + 1) * m])
+            {
                 self.state = FmiState::Error;
                 return Err(e);
             }
