@@ -131,7 +131,7 @@ def simulate(fmu, md, values, duration, t_record=0.0, subsample=SUBSAMPLE):
 
 def record(inst, ms, t0, t_end, subsample=SUBSAMPLE):
     """Step an initialised instance from t0 to t_end on the grid t0 + n h, reading the forces
-    at every point (straight into the result's memory) and the impact counters between reads;
+    at every point and the impact counters between reads;
     an impact is then placed at its force's onset within that interval.
 
     Where the FMU's binary exports SAMPLED (docs/SOUND.md, "The force"), each CHUNK of the
@@ -148,35 +148,36 @@ def record(inst, ms, t0, t_end, subsample=SUBSAMPLE):
     counted = [j for j, x in enumerate(ms) if x.counters]
     vr_c = (ctypes.c_uint * (2 * len(counted)))(
         *[c.valueReference for j in counted for c in ms[j].counters])
-    F = np.zeros((n + 1, m))
+    F = np.zeros((m, n + 1))  # each mesh's force contiguous, for the filters
     do_step, get_real, get_int = _raw_calls(inst)
     sampled = _sampled_call(inst)
     every = max(1, int(round(CHUNK / h))) if sampled else subsample
     at = np.unique(np.r_[np.arange(0, n + 1, every), n])  # where the counters are read
     C = np.zeros((len(at), len(vr_c)), dtype=np.int32)  # fmi2Integer
+    rows = np.zeros((every, m))  # the forces between two counter reads, as the FMU writes them
     comp, row, ends = inst.component, 8 * m, at.tolist()
-    f_at, c_at = F.ctypes.data, C.ctypes.data
+    r_at, c_at = rows.ctypes.data, C.ctypes.data
     vf, vc, n_c = ctypes.addressof(vr_f), ctypes.addressof(vr_c), len(vr_c)  # (arrays kept)
-    get_real(comp, vf, m, f_at)
+    get_real(comp, vf, m, r_at)
+    F[:, 0] = rows[0]
     if counted:
         get_int(comp, vc, n_c, c_at)
     for i in range(1, len(ends)):
         k0, k1 = ends[i - 1], ends[i]
         if sampled:
-            _ok(sampled(comp, t0 + k0 * h, h, k1 - k0, vf, m, f_at + row * (k0 + 1)), SAMPLED,
-                t0 + k0 * h)
+            _ok(sampled(comp, t0 + k0 * h, h, k1 - k0, vf, m, r_at), SAMPLED, t0 + k0 * h)
         else:
             for k in range(k0 + 1, k1 + 1):
                 _ok(do_step(comp, t0 + (k - 1) * h, h, 1), "fmi2DoStep", t0 + (k - 1) * h)
-                get_real(comp, vf, m, f_at + row * k)
+                get_real(comp, vf, m, r_at + row * (k - k0 - 1))
+        F[:, k0 + 1:k1 + 1] = rows[:k1 - k0].T
         if counted:
             get_int(comp, vc, n_c, c_at + 4 * n_c * i)
-    impacts = [_from_force(F[:, j], t0, h) for j in range(m)]
     C = C.astype(np.int64)
+    impacts = [None if x.counters else _from_force(F[j], t0, h) for j, x in enumerate(ms)]
     for col, j in enumerate(counted):
-        impacts[j] = _from_counters(at, C[:, 2 * col], C[:, 2 * col + 1], F[:, j], t0, h)
-    return Run(h=h, t0=t0, forces=[F[:, j].copy() for j in range(m)], impacts=impacts,
-               meshes=ms, values={}, steps=n)
+        impacts[j] = _from_counters(at, C[:, 2 * col], C[:, 2 * col + 1], F[j], t0, h)
+    return Run(h=h, t0=t0, forces=list(F), impacts=impacts, meshes=ms, values={}, steps=n)
 
 
 def _ok(status, name, t):
@@ -226,7 +227,8 @@ def _from_counters(at, n_plus, n_minus, F, t0, h):
     for flank, c, sign in ((1, n_plus, 1.0), (2, n_minus, -1.0)):
         for i in np.nonzero(np.diff(c) > 0)[0]:
             lo, hi = at[i], at[i + 1]
-            inside = onsets[(onsets > lo) & (onsets <= hi)]
+            a, b = np.searchsorted(onsets, [lo, hi], "right")
+            inside = onsets[a:b]
             signed = inside[np.sign(F[inside]) == sign]
             inside = signed if len(signed) else inside
             for q in range(int(c[i + 1] - c[i])):

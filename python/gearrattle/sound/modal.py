@@ -100,14 +100,14 @@ class ModalTransfer:
         D = decimate
         M = (len(force) - 1) // D  # intervals of D samples
         p = np.zeros(M + 1)
-        # (M, D + 1): row m holds F[m D] .. F[m D + D]
-        blocks = np.lib.stride_tricks.sliding_window_view(force[:M * D + 1], D + 1)[::D]
+        # F[m D + j] for m = 0 .. M − 1, one array for each j = 0 .. D
+        shifted = [force[j:j + M * D:D] for j in range(D + 1)]
         for m in self.modes:
             g = m.gain(mesh)
             if not g:
                 continue
             lam, c, r, s1 = foh_recursion(m, h, D)
-            u = blocks @ c.real + 1j * (blocks @ c.imag)
+            u = sum(cj * fj for cj, fj in zip(c, shifted))
             x0 = -force[0] / s1  # the state under the constant force F[0]
             x = lfilter([1.0], [1.0, -lam], u, zi=[lam * x0])[0]
             p[0] += 2 * g * (r * x0).real
