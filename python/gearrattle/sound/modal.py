@@ -20,7 +20,7 @@ its linear interpolant,
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.signal import lfilter
+from scipy.signal import lfilter, lfiltic
 
 
 @dataclass(frozen=True)
@@ -75,6 +75,27 @@ def foh_recursion(mode, h, decimate=1):
     return e ** D, c, r, s1
 
 
+def _real_part(recursion, shifted, F0):
+    """Re(r x[m]) for m = 0 .. M of a mode's recursion (lam, c, r, s1) driven by the shifted
+    force samples, x[0] = −F0/s1 (the state under the constant force F0), as one real
+    second-order recursion: Re(r x) has the poles lam and conj(lam), so it is
+    A(z) = 1 − 2 Re(lam) z⁻¹ + |lam|² z⁻² applied to Re(r (1 − conj(lam) z⁻¹) u), u the
+    complex input sum_j c[j] F[m D + j], plus the free response of x[0] (as initial
+    conditions)."""
+    lam, c, r, s1 = recursion
+    u_re = np.zeros(len(shifted[0]) + 1)
+    u_im = np.zeros(len(shifted[0]) + 1)
+    for cj, fj in zip(c, shifted):
+        u_re[1:] += cj.real * fj
+        u_im[1:] += cj.imag * fj
+    rl = r * np.conj(lam)
+    v = r.real * u_re - r.imag * u_im
+    v[1:] -= rl.real * u_re[:-1] - rl.imag * u_im[:-1]
+    a = [1.0, -2 * lam.real, abs(lam) ** 2]
+    w = r * (-F0 / s1)  # Re(w lam^m), m = -1, -2: the free response before the start
+    return lfilter([1.0], a, v, zi=lfiltic([1.0], a, [(w / lam).real, (w / lam ** 2).real]))[0]
+
+
 class ModalTransfer:
     """Modes shared by every mesh, each mesh with its own gains."""
 
@@ -104,14 +125,8 @@ class ModalTransfer:
         shifted = [force[j:j + M * D:D] for j in range(D + 1)]
         for m in self.modes:
             g = m.gain(mesh)
-            if not g:
-                continue
-            lam, c, r, s1 = foh_recursion(m, h, D)
-            u = sum(cj * fj for cj, fj in zip(c, shifted))
-            x0 = -force[0] / s1  # the state under the constant force F[0]
-            x = lfilter([1.0], [1.0, -lam], u, zi=[lam * x0])[0]
-            p[0] += 2 * g * (r * x0).real
-            p[1:] += 2 * g * (r * x).real
+            if g:
+                p += 2 * g * _real_part(foh_recursion(m, h, D), shifted, force[0])
         return p
 
     def render(self, force, mesh, subsample):
