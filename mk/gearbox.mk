@@ -11,4 +11,4 @@ test-python: $(GEARBOX_FMU)
 
 ## bench-gearbox: the gearbox's cost against its gears one by one, scipy, a map, n_gears
 bench-gearbox: fmu $(VENV)/.installed
-	$(PY) scripts/bench_gearbox.py
+	$(BENCH_PY) scripts/bench_gearbox.py

@@ -9,9 +9,9 @@ import time
 
 import numpy as np
 
-from . import gearbox_fmu as GF
-from . import gearbox_reference as R
-from .masters import GEAR_FMU
+from gearrattle import gearbox_fmu as GF
+from gearrattle import gearbox_reference as R
+from gearrattle.masters import GEAR_FMU
 
 T_END, H = 2.0, 1e-4
 WINDOW = 0.35  # B1's pointwise-predictable window: errors are measured over it
