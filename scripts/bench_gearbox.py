@@ -1,6 +1,6 @@
 """The gearbox benchmark (`make bench-gearbox`): prints its figures and writes them into
-docs/GEARBOX.md's benchmark section (between its two bench-gearbox markers) and the plot
-docs/gearbox_cost.png (benches/gearbox).
+docs/GEARBOX.md's benchmark section (between its two bench-gearbox markers) and the plots
+docs/gearbox_cost.png and docs/gearbox_work_precision.png (benches/gearbox).
 
     PYTHONPATH=benches .venv/bin/python scripts/bench_gearbox.py [--map-x rpm=600:1000:40] [--map-y T_oil=-10:90:25] [--no-write] [--no-map]
 """

@@ -1,6 +1,7 @@
 """The run of `make bench-gearbox` (`run`): each measurement printed as one line, the lines
 written into docs/GEARBOX.md between its two bench-gearbox markers, the cost against n_gears
-drawn into docs/gearbox_cost.png."""
+drawn into docs/gearbox_cost.png, the work against precision into
+docs/gearbox_work_precision.png (its points in target/bench_gearbox/work_precision.csv)."""
 
 from __future__ import annotations
 
@@ -14,9 +15,12 @@ from gearrattle import gearbox_fmu as GF
 from gearrattle.study.cli import main as study
 
 from gearbox import runs as B
+from gearbox import work_precision as WP
 
 DOC = GF.ROOT / "docs" / "GEARBOX.md"
 PLOT = GF.ROOT / "docs" / "gearbox_cost.png"
+WP_PLOT = GF.ROOT / "docs" / "gearbox_work_precision.png"
+OUT = GF.ROOT / "target" / "bench_gearbox"
 BEGIN, END = "<!-- bench-gearbox:begin -->", "<!-- bench-gearbox:end -->"
 
 
@@ -47,14 +51,13 @@ def run(map_x: str, map_y: str, write: bool = True, with_map: bool = True) -> in
         f"GearRattle instances on the input-side motion recorded from it (theta, omega, alpha at "
         f"every step): {wall_gears:.2f} s together ({wall_gears / wall_box:.2f} x). Both times "
         f"include the Python loop's FMI calls.")
-    err, cost = B.fmu_error_and_cost()
-    rtol, err_s, cost_s = B.scipy_at_error(err)
-    say(f"- Accuracy against cost over B1's predictable window ({B.WINDOW:g} s): the FMU at its "
-        f"default tolerance (1e-6) errs by {err:.1e} G and costs {cost:.2f} s per simulated second; "
-        f"scipy's DOP853 on the same equations (the reference, edges located) reaches "
-        f"{err_s:.1e} G at rtol {rtol:g} for {cost_s:.1f} s per simulated second "
-        f"({cost_s / cost:.0f} x).")
-    points, wall_map, code = rattle_map(map_x, map_y, "target/bench_gearbox/map") if with_map else (0, 0.0, None)
+    ref = WP.Reference()
+    curves = WP.sweep(ref)
+    WP.write_csv(OUT / "work_precision.csv", curves)
+    wp_rows = WP.ratios(curves, ref)
+    for text in WP.summary(curves, ref, wp_rows):
+        say(text)
+    points, wall_map, code = rattle_map(map_x, map_y, str(OUT / "map")) if with_map else (0, 0.0, None)
     if code is None:
         pass
     elif code == 0:
@@ -68,11 +71,12 @@ def run(map_x: str, map_y: str, write: bool = True, with_map: bool = True) -> in
     if not write:
         return 0
     B.cost_figure(PLOT, rows)
+    WP.figure(WP_PLOT, curves, ref, wp_rows)
     text = DOC.read_text()
     block = f"{BEGIN}\nMeasured with `make bench-gearbox` ({time.strftime('%Y-%m-%d')}):\n\n" + "\n".join(lines) + f"\n{END}"
     if BEGIN not in text:
         print(f"{DOC} has no {BEGIN} marker: nothing written", file=sys.stderr)
         return 1
     DOC.write_text(re.sub(re.escape(BEGIN) + ".*?" + re.escape(END), lambda _: block, text, flags=re.S))
-    print(f"written into {DOC} and {PLOT}")
+    print(f"written into {DOC}, {PLOT} and {WP_PLOT}")
     return 0
