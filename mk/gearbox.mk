@@ -1,7 +1,9 @@
 # GearboxRattle (docs/GEARBOX.md), built by `make fmu`: its tests' prerequisites, and
 # `make bench-gearbox`, a benchmark that prints its figures and writes them into
-# docs/GEARBOX.md's benchmark section and docs/gearbox_cost.png (no timed assertion; about
-# 4 min on the 2-core machine, most of it the 1 000-point rattle map).
+# docs/GEARBOX.md's benchmark section, docs/gearbox_cost.png and docs/gearbox_work_precision.png
+# (no timed assertion; 5-8 min on the 2-core machine, most of it scipy's work-precision sweep
+# and the 1 000-point rattle map). Its Python (benches/gearbox) runs with benches/ on the
+# import path (BENCH_PY, mk/bench.mk).
 
 .PHONY: bench-gearbox
 
@@ -9,6 +11,6 @@
 # Flywheel partner's, coupled by libcosim and Ecos).
 test-python: $(GEARBOX_FMU)
 
-## bench-gearbox: the gearbox's cost against its gears one by one, scipy, a map, n_gears
+## bench-gearbox: the gearbox's cost against its gears one by one, scipy at equal error, a map, n_gears
 bench-gearbox: fmu $(VENV)/.installed
-	$(PY) scripts/bench_gearbox.py
+	$(BENCH_PY) scripts/bench_gearbox.py

@@ -1,34 +1,14 @@
 """The gearbox benchmark (`make bench-gearbox`): prints its figures and writes them into
-docs/GEARBOX.md's benchmark section (between its two bench-gearbox markers) and the plot
-docs/gearbox_cost.png (gearrattle.gearbox_bench).
+docs/GEARBOX.md's benchmark section (between its two bench-gearbox markers) and the plots
+docs/gearbox_cost.png and docs/gearbox_work_precision.png (benches/gearbox).
 
-    .venv/bin/python scripts/bench_gearbox.py [--map-x rpm=600:1000:40] [--map-y T_oil=-10:90:25] [--no-write]
+    PYTHONPATH=benches .venv/bin/python scripts/bench_gearbox.py [--map-x rpm=600:1000:40] [--map-y T_oil=-10:90:25] [--no-write] [--no-map]
 """
 
 import argparse
-import os
-import re
-import shutil
 import sys
-import time
 
-from gearrattle import gearbox_bench as B
-from gearrattle import gearbox_fmu as GF
-from gearrattle.study.cli import main as study
-
-DOC = B.GF.ROOT / "docs" / "GEARBOX.md"
-PLOT = B.GF.ROOT / "docs" / "gearbox_cost.png"
-BEGIN, END = "<!-- bench-gearbox:begin -->", "<!-- bench-gearbox:end -->"
-
-
-def rattle_map(x, y, out):
-    """gearrattle-study map of the box (2 s per point, 2 workers): (points, wall time, exit code)."""
-    nx, ny = (int(a.rsplit(":", 1)[1]) for a in (x, y))
-    shutil.rmtree(out, ignore_errors=True)  # else the study resumes the points it finds there
-    t0 = time.perf_counter()
-    code = study(["map", "--fmu", str(GF.GEARBOX_FMU), "--x", x, "--y", y, "--duration", "2",
-                  "--stats-from", "0.5", "--workers", "2", "--quiet", "--out", out])
-    return nx * ny, time.perf_counter() - t0, code
+from gearbox.report import run
 
 
 def main(argv=None):
@@ -38,50 +18,7 @@ def main(argv=None):
     ap.add_argument("--no-write", action="store_true", help="print only")
     ap.add_argument("--no-map", action="store_true", help="leave the rattle map out")
     a = ap.parse_args(argv)
-    lines = []
-
-    def say(text):
-        print(text, flush=True)
-        lines.append(text)
-
-    load = open("/proc/loadavg").read().split()[:3]
-    say(f"Machine: {os.cpu_count()} cores, load average {' '.join(load)} at the start.")
-    wall_box, rec = B.coupled_box()
-    wall_gears = B.gears_one_by_one(rec)
-    say(f"- Coupled default box (excitation 1, {B.T_END:g} s, communication steps of {B.H:g} s, "
-        f"stepped by fmpy's FMU2Slave): {wall_box:.2f} s; its five gears stepped one by one as "
-        f"GearRattle instances on the input-side motion recorded from it (theta, omega, alpha at "
-        f"every step): {wall_gears:.2f} s together ({wall_gears / wall_box:.2f} x). Both times "
-        f"include the Python loop's FMI calls.")
-    err, cost = B.fmu_error_and_cost()
-    rtol, err_s, cost_s = B.scipy_at_error(err)
-    say(f"- Accuracy against cost over B1's predictable window ({B.WINDOW:g} s): the FMU at its "
-        f"default tolerance (1e-6) errs by {err:.1e} G and costs {cost:.2f} s per simulated second; "
-        f"scipy's DOP853 on the same equations (the reference, edges located) reaches "
-        f"{err_s:.1e} G at rtol {rtol:g} for {cost_s:.1f} s per simulated second "
-        f"({cost_s / cost:.0f} x).")
-    points, wall_map, code = (0, 0.0, None) if a.no_map else rattle_map(a.map_x, a.map_y, "target/bench_gearbox/map")
-    if code is None:
-        pass
-    elif code == 0:
-        say(f"- Rattle map of the box with gearrattle-study ({points} points {a.map_x} x {a.map_y}, "
-            f"2 s each, 2 workers): {wall_map:.0f} s, {wall_map / points:.2f} s per point.")
-    else:
-        say(f"- Rattle map with gearrattle-study: FAILED (exit code {code}) on {a.map_x} x {a.map_y}.")
-    rows = B.cost_per_gear_count()
-    say("- Wall time per simulated second against n_gears (2 s at 1 ms communication steps): "
-        + ", ".join(f"{n}: {c:.2f} s" for n, c in rows) + " (docs/gearbox_cost.png).")
-    if a.no_write:
-        return 0
-    B.cost_figure(PLOT, rows)
-    text = DOC.read_text()
-    block = f"{BEGIN}\nMeasured with `make bench-gearbox` ({time.strftime('%Y-%m-%d')}):\n\n" + "\n".join(lines) + f"\n{END}"
-    if BEGIN not in text:
-        print(f"{DOC} has no {BEGIN} marker: nothing written", file=sys.stderr)
-        return 1
-    DOC.write_text(re.sub(re.escape(BEGIN) + ".*?" + re.escape(END), lambda _: block, text, flags=re.S))
-    print(f"written into {DOC} and {PLOT}")
-    return 0
+    return run(a.map_x, a.map_y, write=not a.no_write, with_map=not a.no_map)
 
 
 if __name__ == "__main__":

@@ -408,10 +408,10 @@ def simulate(
     speed with xi_i(0) = gap_start_i G_i).
 
     p: full parameter dict (see `params`); t_eval: increasing output times in [0, t_end]
-    (default: 0 and t_end); method: 'DOP853' or 'Radau'; rtol: relative tolerance, the
-    absolute ones being rtol times phi_1, 1 rad/s (phi_dot), 1 rad/s (w_F), 1 rad (q_F),
-    G_i, 100 G_i /s (below the gears' speeds in the gap, so that rtol rules) and e_scale
-    [J] for the quadratures."""
+    (default: 0 and t_end); method: 'DOP853', 'Radau' or another of piecewise.SOLVERS;
+    rtol: relative tolerance, the absolute ones being rtol times phi_1, 1 rad/s (phi_dot),
+    1 rad/s (w_F), 1 rad (q_F), G_i, 100 G_i /s (below the gears' speeds in the gap, so that
+    rtol rules) and e_scale [J] for the quadratures."""
     p = params() if p is None else dict(p)
     if p["excitation"] != 1:
         raise ValueError("the reference has the built-in engine only (excitation = 1)")

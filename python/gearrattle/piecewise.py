@@ -8,10 +8,12 @@ sides and what a crossing means stay in each reference, written from its specifi
 from __future__ import annotations
 
 import numpy as np
-from scipy.integrate import DOP853, Radau
+from scipy.integrate import BDF, DOP853, LSODA, RK45, Radau
 from scipy.optimize import brentq
 
-SOLVERS = {"DOP853": DOP853, "Radau": Radau}
+# DOP853 makes the references, Radau checks them; all five of solve_ivp's methods step the
+# gearbox's for its benchmark against scipy (benches/gearbox).
+SOLVERS = {"RK45": RK45, "DOP853": DOP853, "LSODA": LSODA, "Radau": Radau, "BDF": BDF}
 # The root searches' tolerances: an edge's time to a few rounding errors.
 BRENT_RTOL = 4.0 * np.finfo(float).eps
 XTOL = 1e-16

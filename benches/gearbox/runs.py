@@ -1,60 +1,79 @@
-"""The gearbox benchmark (`make bench-gearbox`, docs/GEARBOX.md's benchmark section): what the
-coupled box costs against its gears stepped one by one as GearRattle instances on the same
-input-side motion, against scipy on the same equations at equal error, over a rattle map,
+"""The FMUs of the gearbox benchmark stepped by fmpy's FMU2Slave and timed: the coupled box
+against its gears stepped one by one as GearRattle instances on the same input-side motion,
 and against the number of gears. Wall times on this machine; no assertion."""
 
 from __future__ import annotations
 
+import functools
 import time
 
 import numpy as np
 
-from . import gearbox_fmu as GF
-from . import gearbox_reference as R
-from .masters import GEAR_FMU
+from gearrattle import gearbox_fmu as GF
+from gearrattle import gearbox_reference as R
+from gearrattle.masters import GEAR_FMU
 
 T_END, H = 2.0, 1e-4
-WINDOW = 0.35  # B1's pointwise-predictable window: errors are measured over it
 SHARED = ("I_L", "r_L", "r_M", "G", "K_star", "alpha", "epsilon", "C_LM", "C", "B", "gap_start")
 
 
-class Stepper:
-    """An FMU2Slave stepped by hand at H, its outputs read by name after each step."""
+@functools.lru_cache(maxsize=None)
+def _unzipped(fmu: str):
+    """The FMU's model description and the directory it is unzipped into, once per process."""
+    from fmpy import extract, read_model_description
 
-    def __init__(self, fmu, name, start: dict, tol=None):
-        from fmpy import extract, read_model_description
+    return read_model_description(fmu), extract(fmu)
+
+
+class Stepper:
+    """An FMU2Slave (its library loaded) stepped by hand, its outputs read by name after each
+    step. `start` instantiates it: what a run costs counts from there."""
+
+    def __init__(self, fmu, name):
         from fmpy.fmi2 import FMU2Slave
 
-        md = read_model_description(str(fmu))
+        md, unzipped = _unzipped(str(fmu))
         self.vrs = {v.name: v.valueReference for v in md.modelVariables}
-        self.fmu = FMU2Slave(guid=md.guid, unzipDirectory=extract(str(fmu)),
+        self.fmu = FMU2Slave(guid=md.guid, unzipDirectory=unzipped,
                              modelIdentifier=md.coSimulation.modelIdentifier, instanceName=name)
+
+    def start(self, start: dict, tol=None):
+        """Instantiated at the tolerance `tol` (None: the FMU's own) and left in
+        initialization mode with the start values `start` set."""
         self.fmu.instantiate()
         self.fmu.setupExperiment(tolerance=tol, startTime=0.0)
         self.fmu.enterInitializationMode()
         for k, v in start.items():
             (self.fmu.setInteger if isinstance(v, int) else self.fmu.setReal)([self.vrs[k]], [v])
+        return self
 
     def refs(self, names):
         return [self.vrs[n] for n in names]
+
+    def record(self, names, n: int, h: float) -> np.ndarray:
+        """n steps of h from t = 0: the outputs `names` at every communication point, (n + 1, len(names))."""
+        refs = self.refs(names)
+        rec = np.empty((n + 1, len(names)))
+        rec[0] = self.fmu.getReal(refs)
+        for k in range(n):
+            self.fmu.doStep(k * h, h)
+            rec[k + 1] = self.fmu.getReal(refs)
+        return rec
+
+    def free(self):
+        self.fmu.terminate()
+        self.fmu.freeInstance()
 
 
 def coupled_box(t_end=T_END, names=("theta_I_out", "omega_I_out", "alpha_I_out"), h=H, tol=None, **start):
     """The box (by default the defaults, excitation 1) stepped at h: the wall time [s] of the
     steps and the outputs `names` at every communication point, (steps + 1, len(names))."""
-    s = Stepper(GF.GEARBOX_FMU, "box", start, tol)
+    s = Stepper(GF.GEARBOX_FMU, "box").start(start, tol)
     s.fmu.exitInitializationMode()
-    refs = s.refs(names)
-    n = int(round(t_end / h))
-    rec = np.empty((n + 1, len(names)))
-    rec[0] = s.fmu.getReal(refs)
     t0 = time.perf_counter()
-    for k in range(n):
-        s.fmu.doStep(k * h, h)
-        rec[k + 1] = s.fmu.getReal(refs)
+    rec = s.record(names, int(round(t_end / h)), h)
     wall = time.perf_counter() - t0
-    s.fmu.terminate()
-    s.fmu.freeInstance()
+    s.free()
     return wall, rec
 
 
@@ -66,7 +85,7 @@ def gears_one_by_one(rec, t_end=T_END):
     n = int(round(t_end / H))
     for i in range(1, p["n_gears"] + 1):
         start = {k: p[f"gear[{i}].{k}"] for k in SHARED}
-        s = Stepper(GEAR_FMU, f"gear{i}", start)
+        s = Stepper(GEAR_FMU, f"gear{i}").start(start)
         inputs = s.refs(["theta_M", "omega_M", "alpha_M"])
         s.fmu.setReal(inputs, list(rec[0]))
         s.fmu.exitInitializationMode()
@@ -75,38 +94,8 @@ def gears_one_by_one(rec, t_end=T_END):
             s.fmu.setReal(inputs, list(rec[k]))
             s.fmu.doStep(k * H, H)
         wall += time.perf_counter() - t0
-        s.fmu.terminate()
-        s.fmu.freeInstance()
+        s.free()
     return wall
-
-
-def fmu_error_and_cost(tol=None, t_end=WINDOW):
-    """The FMU's largest |xi_i - xi_ref| / G_i over B1's window at its tolerance `tol` (None:
-    the contract's 1e-6) and its wall time per simulated second."""
-    n = R.params()["n_gears"]
-    wall, xi = coupled_box(t_end, [f"gear[{i}].xi" for i in range(1, n + 1)], tol=tol)
-    return _err(xi.T, R.scene("B1", t_end, H)), wall / t_end
-
-
-def _err(xi, ref) -> float:
-    G = np.array([R.gear(ref.params, i + 1)["G"] for i in range(xi.shape[0])])
-    return float(np.max(np.abs(xi - ref.xi) / G[:, None]))
-
-
-def scipy_at_error(target: float, method="DOP853", t_end=WINDOW):
-    """The reference's solve (scipy's `method`, edges located) at the loosest rtol of a
-    decade ladder whose error over B1's window is at most `target`: (rtol, error, wall time
-    per simulated second)."""
-    ref = R.scene("B1", t_end, H)
-    last = None
-    for rtol in (1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10):
-        t0 = time.perf_counter()
-        res = R.simulate(R.params("B1"), t_end, t_eval=ref.t, method=method, rtol=rtol)
-        wall = (time.perf_counter() - t0) / t_end
-        last = (rtol, _err(res.xi, ref), wall)
-        if last[1] <= target:
-            return last
-    return last
 
 
 def cost_per_gear_count(t_end=T_END, counts=range(1, 9), repeats=3):
