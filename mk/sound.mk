@@ -13,8 +13,8 @@ SOUND_EXAMPLE := target/sound/ab_S1_S3
 
 ## bench-sound: the sound's cost against the simulation alone, and its error against the force's sampling
 bench-sound: fmu $(VENV)/.installed
-	$(PY) -m gearrattle.sound.bench --fmu $(FMU) --duration 1
-	$(PY) -m gearrattle.sound.bench --fmu $(GEARBOX_FMU) --duration 10 --cost
+	$(BENCH_PY) scripts/bench_sound.py --fmu $(FMU) --duration 1
+	$(BENCH_PY) scripts/bench_sound.py --fmu $(GEARBOX_FMU) --duration 10 --cost
 
 ## sound-example: the A/B example of docs/SOUND.md (S1 against S3) -> docs/sound/
 sound-example: fmu $(VENV)/.installed

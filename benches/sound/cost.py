@@ -4,9 +4,8 @@ filtering, of writing the WAV and of the psychoacoustic metrics (MoSQITo), for a
 pressure's error at each subsample against a 32-times-finer grid. With --cost, only the WAV's
 cost against the simulation alone, side by side, and the metrics' (issue #31's 3x target).
 
-    python -m gearrattle.sound.bench --fmu FMU [--duration 1] [--set NAME=VALUE ...] [--cost]"""
+Run by scripts/bench_sound.py."""
 
-import argparse
 import ctypes
 import os
 import tempfile
@@ -32,7 +31,7 @@ def _cpu(f, *args, repeat=3):
 def _initialised(unzipdir, md, values):
     from fmpy import instantiate_fmu
 
-    from .meshes import _set
+    from gearrattle.sound.meshes import _set
 
     inst = instantiate_fmu(unzipdir, md, fmi_type="CoSimulation")
     inst.setupExperiment(startTime=0.0)
@@ -60,7 +59,7 @@ def alone(unzipdir, md, values, duration):
 def reads_alone(unzipdir, md, values, n):
     """CPU of the reads of n steps of meshes.record (the forces at every step, the counters at
     every WAV sample) without the steps: what calling the FMU's getters from Python costs."""
-    from .meshes import SUBSAMPLE, _raw_calls, meshes
+    from gearrattle.sound.meshes import SUBSAMPLE, _raw_calls, meshes
 
     ms = meshes(md, values)
     inst = _initialised(unzipdir, md, values)
@@ -84,7 +83,7 @@ def sampled_alone(unzipdir, md, values, duration, read):
     """CPU of meshes.record's calls of the FMU's sampling entry over duration (CHUNK each),
     reading the forces at every point if `read`, else none: the FMU's part of the stepping.
     None where the FMU does not export the entry."""
-    from .meshes import CHUNK, FS, SUBSAMPLE, _sampled_call, meshes
+    from gearrattle.sound.meshes import CHUNK, FS, SUBSAMPLE, _sampled_call, meshes
 
     ms = meshes(md, values) if read else []
     inst = _initialised(unzipdir, md, values)
@@ -108,10 +107,10 @@ def sampled_alone(unzipdir, md, values, duration, read):
 def cost(fmu, unzip, md, values, duration):
     """Print the CPU of the simulation alone, of the WAV (the forces sampled, filtered, the mix
     and stems written) and of the metrics, best of 3 for the first two."""
-    from .meshes import CHUNK, SAMPLED, SUBSAMPLE, simulate
-    from .metrics import full_scale, metrics, write_wav
-    from .modal import ModalTransfer
-    from .render import render
+    from gearrattle.sound.meshes import CHUNK, SAMPLED, SUBSAMPLE, simulate
+    from gearrattle.sound.metrics import full_scale, metrics, write_wav
+    from gearrattle.sound.modal import ModalTransfer
+    from gearrattle.sound.render import render
 
     def wav():
         run = simulate(unzip, md, values, duration)
@@ -138,39 +137,35 @@ def cost(fmu, unzip, md, values, duration):
               f"steps alone {steps:.3f}, with the forces read at each point {read:.3f}")
 
 
-def main(argv=None):
+def report(fmu, duration, sets, cost_only=False):
+    """Prints the sound's cost and error against the force's sampling for the FMU's scene with
+    the `sets` (NAME=VALUE texts), `duration` seconds simulated; with `cost_only`, only the
+    WAV's cost against the simulation alone, and the metrics'."""
     import mosqito
     from fmpy import extract, read_model_description
 
-    from ..study.spec import parse_set
-    from .meshes import SAMPLED, SUBSAMPLE, simulate, start_values
-    from .metrics import full_scale, metrics, write_wav
-    from .modal import ModalTransfer
-    from .render import render
+    from gearrattle.study.spec import parse_set
+    from gearrattle.sound.meshes import SAMPLED, SUBSAMPLE, simulate, start_values
+    from gearrattle.sound.metrics import full_scale, metrics, write_wav
+    from gearrattle.sound.modal import ModalTransfer
+    from gearrattle.sound.render import render
 
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--fmu", default=os.path.join("target", "fmu", "GearRattle.fmu"))
-    ap.add_argument("--duration", type=float, default=1.0)
-    ap.add_argument("--set", action="append", default=[], metavar="NAME=VALUE")
-    ap.add_argument("--cost", action="store_true",
-                    help="only the WAV's cost against the simulation alone, and the metrics'")
-    a = ap.parse_args(argv)
-    md = read_model_description(a.fmu)
-    unzip = extract(a.fmu)
-    values = start_values(md, dict(parse_set(t, f"--set {t}") for t in a.set))
-    if a.cost:
-        return cost(a.fmu, unzip, md, values, a.duration)
+    md = read_model_description(fmu)
+    unzip = extract(fmu)
+    values = start_values(md, dict(parse_set(t, f"--set {t}") for t in sets))
+    if cost_only:
+        return cost(fmu, unzip, md, values, duration)
     transfer = ModalTransfer()
-    t_alone = min(alone(unzip, md, values, a.duration) for _ in range(3))
-    ref = simulate(unzip, md, values, a.duration, subsample=REFERENCE)
+    t_alone = min(alone(unzip, md, values, duration) for _ in range(3))
+    ref = simulate(unzip, md, values, duration, subsample=REFERENCE)
     p_ref = render(ref, transfer, REFERENCE).mix
-    print(f"sound of {a.fmu} ({', '.join(f'{k} = {v:g}' for k, v in values.items())}), "
-          f"{a.duration:g} s simulated, default modal housing; CPU seconds, best of 3")
+    print(f"sound of {fmu} ({', '.join(f'{k} = {v:g}' for k, v in values.items())}), "
+          f"{duration:g} s simulated, default modal housing; CPU seconds, best of 3")
     print(f"  simulation alone (one fmi2DoStep): {t_alone:.4f} s")
     print(f"  {'subsample':>9s} {'step [us]':>9s} {'simulation':>10s} {'filtering':>9s} "
           f"{'max error':>9s} {'RMS error':>9s}   (error of p against subsample {REFERENCE})")
     for sub in SUBSAMPLES:
-        t_sim, run = _cpu(simulate, unzip, md, values, a.duration, 0.0, sub)
+        t_sim, run = _cpu(simulate, unzip, md, values, duration, 0.0, sub)
         t_filt, snd = _cpu(render, run, transfer, sub)
         e = snd.mix - p_ref
         mark = "  <- used" if sub == SUBSAMPLE else ""
@@ -179,9 +174,9 @@ def main(argv=None):
               f"{np.sqrt(np.mean(e ** 2) / np.mean(p_ref ** 2)):9.1e}{mark}")
         if sub == SUBSAMPLE:
             mix, steps, t_grid = snd.mix, run.steps, t_sim
-    t_steps = min(sampled_alone(unzip, md, values, a.duration, False) or 0 for _ in range(3))
+    t_steps = min(sampled_alone(unzip, md, values, duration, False) or 0 for _ in range(3))
     if t_steps:
-        t_read = min(sampled_alone(unzip, md, values, a.duration, True) for _ in range(3))
+        t_read = min(sampled_alone(unzip, md, values, duration, True) for _ in range(3))
         print(f"  of the simulation at subsample {SUBSAMPLE} ({t_grid:.3f} s, {steps} steps): "
               f"inside the FMU ({SAMPLED}) the steps alone {t_steps:.3f} s, with the forces "
               f"read at each {t_read:.3f} s")
@@ -198,6 +193,3 @@ def main(argv=None):
     print(f"  N5 {m.N5:.2f} sone, N_mean {m.N_mean:.2f} sone, sharpness {m.sharpness:.2f} acum, "
           f"LAeq {m.LAeq:.1f} dB(A)")
 
-
-if __name__ == "__main__":
-    main()
