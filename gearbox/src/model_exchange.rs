@@ -23,8 +23,8 @@ use crate::simulation::{Run, Simulation};
 use crate::windowed::{self, integrals, integrands};
 use fmi2_shell::Continuous;
 use gear_rattle::gearbox::{
-    Drive, E_DAMPER, E_INPUT_DRAG, Gearbox, MAX_GEARS, PHI, PHI_DOT, State, THETA_F,
-    W_FLYWHEEL, e_contact, e_lubricant, omega_F, xi, xi_dot,
+    Drive, E_DAMPER, E_INPUT_DRAG, Gearbox, MAX_GEARS, PHI, PHI_DOT, State, THETA_F, W_FLYWHEEL,
+    e_contact, e_lubricant, omega_F, xi, xi_dot,
 };
 use gear_rattle::integrator::Piecewise;
 use gear_rattle::physics::{Polynomial, Region, Shaft};
