@@ -133,7 +133,8 @@ fn outputs_move_with_inputs_only_where_declared() {
 
 /// Model Exchange at the start with every gear in contact, for each drive and the engine
 /// ramped, before the statistics window opens and 1 ms into it: each continuous state, and
-/// each input of the drive, moves only the outputs and derivatives that name it.
+/// each input of the drive, moves only the outputs and derivatives that name it; the states
+/// of the slots beyond the box's five gears are 0, and so are their derivatives.
 #[test]
 fn model_exchange_moves_only_where_declared() {
     let drives = [(0, 0.0), (1, 0.0), (1, -150.0), (2, 0.0)];
@@ -158,6 +159,20 @@ fn model_exchange_moves_only_where_declared() {
         sim.set_time(1e-3);
         sim.set_drive_inputs(flywheel, input_side);
         let x = sim.continuous_states();
+        let dx = sim.derivatives();
+        for (k, state) in STATES.iter().enumerate() {
+            let name = contract::find(Kind::Real, *state).unwrap().name;
+            if ["gear[6]", "gear[7]", "gear[8]"]
+                .iter()
+                .any(|g| name.starts_with(g))
+            {
+                assert_eq!(
+                    (x[k], dx[k]),
+                    (0.0, 0.0),
+                    "{name} of a slot beyond the five gears"
+                );
+            }
+        }
         for (k, state) in STATES.iter().enumerate() {
             let name = contract::find(Kind::Real, *state).unwrap().name;
             let _ = moved_only_where_declared(&sim, name, |s| {
