@@ -5,42 +5,58 @@
 //! States (the contract's `STATES`): φ, the input side's speed ω_I (the model integrates
 //! φ' = ω_F − ω_I: ω_I = ω_F(t) − φ'), the flywheel's θ_F and ω_F under an engine ramp (their
 //! derivatives ω_F and α_F(t): docs/GEARBOX.md §4 has no closed form for them; at a steady
-//! speed or driven by inputs the two are unused, 0), then each gear slot's ξ and ξ' (a slot
-//! beyond n_gears is unused, 0). An unused state's derivative is 0. Event indicators: per
-//! gear slot the contact law's edges ξ + ε, ξ, ξ − G, ξ − G − ε and ξ' in the gap (its
-//! turning points), then the damper's stage edges φ − φ_1 and φ + φ_1. The derivatives take
-//! the formulas of the pieces the states are in; at an event the gearbox's stage and regions
-//! follow them across the edges (an onset counts an impact and enters the statistics), as
-//! the co-simulation's solver does. The energies and the window's integrals are not states
-//! of the contract: in Model Exchange they stay at their start, and so do the statistics
-//! made of them.
+//! speed or driven by inputs the two are unused, 0), the box's energies E_damper,
+//! E_input_drag and W_flywheel, then each gear slot's ξ, ξ', its energies E_contact and
+//! E_lubricant and its statistics window's integrals ∫a² dt, ∫F dt, ∫F² dt (a slot beyond
+//! n_gears is unused, 0). The window's integrals stay 0 until the window opens (a time event
+//! at stats_from), as co-simulation starts them there; the window's figures are the
+//! quadratures' increase since, so every statistic is the importer's integral. An unused
+//! state's derivative is 0. Event indicators: per gear slot the contact law's edges ξ + ε, ξ,
+//! ξ − G, ξ − G − ε and ξ' in the gap (its turning points), then the damper's stage edges
+//! φ − φ_1 and φ + φ_1. The derivatives take the formulas of the pieces the states are in;
+//! at an event the gearbox's stage and regions follow them across the edges (an onset counts
+//! an impact and enters the statistics), as the co-simulation's solver does.
 #![allow(non_snake_case)]
 
 use crate::contract::{EVENT_INDICATORS, STATES};
 use crate::simulation::{Run, Simulation};
-use crate::windowed;
+use crate::windowed::{self, integrals, integrands};
 use fmi2_shell::Continuous;
 use gear_rattle::gearbox::{
-    Drive, Gearbox, MAX_GEARS, PHI, PHI_DOT, State, THETA_F, omega_F, xi, xi_dot,
+    Drive, E_DAMPER, E_INPUT_DRAG, Gearbox, MAX_GEARS, PHI, PHI_DOT, State, THETA_F, W_FLYWHEEL,
+    e_contact, e_lubricant, omega_F, xi, xi_dot,
 };
-use gear_rattle::integrator::{Piecewise, System};
+use gear_rattle::integrator::Piecewise;
 use gear_rattle::physics::{Polynomial, Region, Shaft};
+use gear_rattle::rattle::window::quadrature;
 
 /// Number of continuous states.
-pub const NX: usize = 4 + 2 * MAX_GEARS;
+pub const NX: usize = X_GEARS + GEAR_STATES * MAX_GEARS;
 const _: () = assert!(STATES.len() == NX);
 /// Number of event indicators.
 pub const NZ: usize = EVENT_INDICATORS;
 const _: () = assert!(NZ == 5 * MAX_GEARS + 2);
 
-/// State x's components.
+/// State x's components: the box's, then each gear slot's block.
 const X_PHI: usize = 0;
 const X_OMEGA_I: usize = 1;
 const X_THETA_F: usize = 2;
 const X_OMEGA_F: usize = 3;
-const fn x_xi(i: usize) -> usize {
-    4 + 2 * i
+const X_ENERGIES: usize = 4;
+const X_GEARS: usize = 7;
+/// The gearbox's state components behind the box's energies.
+const ENERGIES: [usize; 3] = [E_DAMPER, E_INPUT_DRAG, W_FLYWHEEL];
+/// A gear's block: ξ, ξ', E_contact, E_lubricant, then its window's three integrals.
+const GEAR_STATES: usize = 7;
+const INTEGRALS: usize = 4;
+const fn x_gear(i: usize) -> usize {
+    X_GEARS + GEAR_STATES * i
 }
+/// The gearbox's state components of gear i's block before its window's integrals.
+const fn gear_components(i: usize) -> [usize; INTEGRALS] {
+    [xi(i), xi_dot(i), e_contact(i), e_lubricant(i)]
+}
+const _: () = assert!(INTEGRALS + 3 == GEAR_STATES && quadrature::COUNT - quadrature::A2 == 3);
 
 impl Continuous for Simulation {
     type States = [f64; NX];
@@ -57,8 +73,17 @@ impl Continuous for Simulation {
         if g.integrates_flywheel() {
             (x[X_THETA_F], x[X_OMEGA_F]) = (y[THETA_F], y[omega_F(g.n_gears())]);
         }
+        for (x, c) in x[X_ENERGIES..X_GEARS].iter_mut().zip(ENERGIES) {
+            *x = y[c];
+        }
         for i in 0..g.n_gears() {
-            (x[x_xi(i)], x[x_xi(i) + 1]) = (y[xi(i)], y[xi_dot(i)]);
+            let block = &mut x[x_gear(i)..x_gear(i + 1)];
+            for (x, c) in block.iter_mut().zip(gear_components(i)) {
+                *x = y[c];
+            }
+            if let Some((_, q)) = self.window(i) {
+                block[INTEGRALS..].copy_from_slice(&q[quadrature::A2..]);
+            }
         }
         x
     }
@@ -74,16 +99,28 @@ impl Continuous for Simulation {
                 y[PHI] = x[X_PHI];
                 y[PHI_DOT] = g.flywheel_at(t, y).omega - x[X_OMEGA_I];
             }
+            for (x, c) in x[X_ENERGIES..X_GEARS].iter().zip(ENERGIES) {
+                y[c] = *x;
+            }
             for i in 0..g.n_gears() {
-                (y[xi(i)], y[xi_dot(i)]) = (x[x_xi(i)], x[x_xi(i) + 1]);
+                for (x, c) in x[x_gear(i)..].iter().zip(gear_components(i)) {
+                    y[c] = *x;
+                }
             }
         });
+        if let Run::Windowed(k) = &mut self.run {
+            for i in 0..k.system.inner.n_gears() {
+                k.y[integrals(i)].copy_from_slice(&x[x_gear(i) + INTEGRALS..x_gear(i + 1)]);
+            }
+        }
     }
 
-    /// dx/dt at the current time and states, with the formulas of the pieces they are in.
+    /// dx/dt at the current time and states, with the formulas of the pieces they are in;
+    /// the window's integrands once it is open.
     fn derivatives(&self) -> [f64; NX] {
         let (g, y) = self.settled();
-        let f = g.rhs(self.t, &y);
+        let l = g.loads(self.t, &y);
+        let f = g.rhs_with(&l, &y);
         let mut dx = [0.0; NX];
         if !matches!(g.drive, Drive::InputSide(_)) {
             dx[X_PHI] = f[PHI];
@@ -92,14 +129,25 @@ impl Continuous for Simulation {
         if g.integrates_flywheel() {
             (dx[X_THETA_F], dx[X_OMEGA_F]) = (f[THETA_F], f[omega_F(g.n_gears())]);
         }
+        for (dx, c) in dx[X_ENERGIES..X_GEARS].iter_mut().zip(ENERGIES) {
+            *dx = f[c];
+        }
+        let open = matches!(self.run, Run::Windowed(_));
         for i in 0..g.n_gears() {
-            (dx[x_xi(i)], dx[x_xi(i) + 1]) = (f[xi(i)], f[xi_dot(i)]);
+            let block = &mut dx[x_gear(i)..x_gear(i + 1)];
+            for (dx, c) in block.iter_mut().zip(gear_components(i)) {
+                *dx = f[c];
+            }
+            if open {
+                block[INTEGRALS..].copy_from_slice(&integrands(&g.gears[i], &l.gears[i]));
+            }
         }
         dx
     }
 
     /// Nominal magnitudes: φ on the scale of φ_1, ω_I and ω_F of 100 rad/s, θ_F of 100 rad
-    /// (a second at idle), each ξ of its backlash and ξ' of a backlash per millisecond.
+    /// (a second at idle), the box's energies of 1 J, each ξ of its backlash and ξ' of a
+    /// backlash per millisecond, a gear's energies and integrals as GearRattle's.
     fn nominals(&self) -> [f64; NX] {
         let (g, _) = self.gearbox();
         let mut x = [1.0; NX];
@@ -107,7 +155,7 @@ impl Continuous for Simulation {
         (x[X_THETA_F], x[X_OMEGA_F]) = (100.0, 100.0);
         for (i, gear) in g.gears.iter().enumerate() {
             let G = gear.dynamics.params.G;
-            (x[x_xi(i)], x[x_xi(i) + 1]) = (G, G * 1e3);
+            x[x_gear(i)..x_gear(i + 1)].copy_from_slice(&[G, G * 1e3, 1e-3, 1e-2, 1e2, 1.0, 1e2]);
         }
         x
     }

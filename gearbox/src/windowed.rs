@@ -8,17 +8,23 @@
 
 use serde::{Deserialize, Serialize};
 
-use gear_rattle::gearbox::{self, Gearbox, MAX_GEARS, State, e_contact, e_lubricant, xi};
+use gear_rattle::gearbox::{self, Gear, Gearbox, MAX_GEARS, State, e_contact, e_lubricant, xi};
 use gear_rattle::integrator::{Crossing, Dense, Jacobian, Piecewise, System, Tolerance};
-use gear_rattle::physics::Region;
+use gear_rattle::physics::{self, Region};
 use gear_rattle::rattle::refine_peak;
 use gear_rattle::rattle::window::{Quadratures, Window, quadrature};
 
 /// The gearbox's state, then ∫a² dt, ∫F dt, ∫F² dt of each gear slot.
 pub const N: usize = gearbox::N + 3 * MAX_GEARS;
-/// Gear i's ∫a² dt (then ∫F dt, ∫F² dt).
-const fn a2(i: usize) -> usize {
-    gearbox::N + 3 * i
+/// Gear i's window integrals ∫a² dt, ∫F dt, ∫F² dt in a windowed state.
+pub const fn integrals(i: usize) -> std::ops::Range<usize> {
+    gearbox::N + 3 * i..gearbox::N + 3 * i + 3
+}
+
+/// The integrands of a gear's window integrals from its loads: a², F, F² with a = r_L α_L.
+pub fn integrands(gear: &Gear, load: &physics::Loads) -> [f64; 3] {
+    let (a, force) = (gear.dynamics.params.r_L * load.alpha_L, load.force.total());
+    [a * a, force, force * force]
 }
 
 /// The gearbox's part of a windowed state.
@@ -89,7 +95,7 @@ pub fn quadratures(y: &[f64; N], i: usize) -> Quadratures {
     let mut q = [0.0; quadrature::COUNT];
     q[quadrature::E_CONTACT] = y[e_contact(i)];
     q[quadrature::E_LUBRICANT] = y[e_lubricant(i)];
-    q[quadrature::A2..].copy_from_slice(&y[a2(i)..a2(i) + 3]);
+    q[quadrature::A2..].copy_from_slice(&y[integrals(i)]);
     q
 }
 
@@ -100,9 +106,7 @@ impl System<N> for Windowed {
         let mut f = [0.0; N];
         f[..gearbox::N].copy_from_slice(&self.inner.rhs_with(&l, &h));
         for (i, gear) in self.inner.gears[..self.inner.n_gears()].iter().enumerate() {
-            let g = &l.gears[i];
-            let (a, force) = (gear.dynamics.params.r_L * g.alpha_L, g.force.total());
-            f[a2(i)..a2(i) + 3].copy_from_slice(&[a * a, force, force * force]);
+            f[integrals(i)].copy_from_slice(&integrands(gear, &l.gears[i]));
         }
         f
     }

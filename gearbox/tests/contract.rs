@@ -132,14 +132,17 @@ fn outputs_move_with_inputs_only_where_declared() {
 }
 
 /// Model Exchange at the start with every gear in contact, for each drive and the engine
-/// ramped: each continuous state, and each input of the drive, moves only the outputs and
-/// derivatives that name it.
+/// ramped, before the statistics window opens and 1 ms into it: each continuous state, and
+/// each input of the drive, moves only the outputs and derivatives that name it; the states
+/// of the slots beyond the box's five gears are 0, and so are their derivatives.
 #[test]
 fn model_exchange_moves_only_where_declared() {
-    for (excitation, rpm_rate) in [(0, 0.0), (1, 0.0), (1, -150.0), (2, 0.0)] {
+    let drives = [(0, 0.0), (1, 0.0), (1, -150.0), (2, 0.0)];
+    for ((excitation, rpm_rate), stats_from) in drives.into_iter().zip([0.5, 0.0, 0.0, 0.0]) {
         let mut values = Values::start(VARIABLES);
         values.set_integer(vr::excitation, excitation);
         values.set_real(vr::rpm_rate, rpm_rate);
+        values.set_real(vr::stats_from, stats_from);
         for g in vr::gear::gap_start {
             values.set_real(g, -0.2);
         }
@@ -150,8 +153,26 @@ fn model_exchange_moves_only_where_declared() {
         ] {
             values.set_real(input, value);
         }
-        let sim = Simulation::new(&values, 0.0, 1e-6, true).unwrap();
+        let flywheel = simulation::flywheel_inputs(&values);
+        let input_side = simulation::input_side_inputs(&values);
+        let mut sim = Simulation::new(&values, 0.0, 1e-6, true).unwrap();
+        sim.set_time(1e-3);
+        sim.set_drive_inputs(flywheel, input_side);
         let x = sim.continuous_states();
+        let dx = sim.derivatives();
+        for (k, state) in STATES.iter().enumerate() {
+            let name = contract::find(Kind::Real, *state).unwrap().name;
+            if ["gear[6]", "gear[7]", "gear[8]"]
+                .iter()
+                .any(|g| name.starts_with(g))
+            {
+                assert_eq!(
+                    (x[k], dx[k]),
+                    (0.0, 0.0),
+                    "{name} of a slot beyond the five gears"
+                );
+            }
+        }
         for (k, state) in STATES.iter().enumerate() {
             let name = contract::find(Kind::Real, *state).unwrap().name;
             let _ = moved_only_where_declared(&sim, name, |s| {
@@ -160,8 +181,6 @@ fn model_exchange_moves_only_where_declared() {
                 s.set_continuous_states(&moved);
             });
         }
-        let flywheel = simulation::flywheel_inputs(&values);
-        let input_side = simulation::input_side_inputs(&values);
         for (k, motion) in ["theta", "omega", "alpha"].into_iter().enumerate() {
             let _ = moved_only_where_declared(&sim, &format!("{motion}_F"), |s| {
                 s.set_drive_inputs(bumped(flywheel, k), input_side)

@@ -20,6 +20,9 @@ from support.gearbox import BUILD_GEARBOX_FMU3, GEARBOX_FMU3_PATH
 
 box3_path, box3_md, box3_unzipdir, vr3 = session_fixtures(
     GEARBOX_FMU3_PATH, BUILD_GEARBOX_FMU3, ("box3_path", "box3_md", "box3_unzipdir", "vr3"))
+# Model Exchange's continuous states: the box's, then each gear's (an array over n_gears).
+BOX_STATES = ["phi", "x_omega_I", "x_theta_F", "x_omega_F", "E_damper", "E_input_drag", "W_flywheel"]
+GEAR_STATES = ["xi", "xi_dot", "E_contact", "E_lubricant", "int_a2", "int_F", "int_F2"]
 
 
 def fmi3_name(fmi2_name: str) -> str:
@@ -63,7 +66,8 @@ def test_validates_with_enumerations_and_arrays(box3_path, box3_md, box_md):
         declared = name.replace("gear.", "gear[{}].")
         if fmi2[declared.format(1)].start is not None:
             assert var[name].start.split() == [fmi2[declared.format(i)].start for i in range(1, 6)], name
-    assert len(box3_md.derivatives) == 6 and box3_md.numberOfContinuousStates == 4 + 2 * 5
+    assert len(box3_md.derivatives) == len(BOX_STATES) + len(GEAR_STATES)
+    assert box3_md.numberOfContinuousStates == len(BOX_STATES) + 5 * len(GEAR_STATES)
     assert len(box3_md.eventIndicators) == 42
     # The same variables as the FMI 2.0 FMU's, the gears' as arrays, besides the time and the
     # event indicators.
@@ -239,28 +243,31 @@ def test_three_gears_set_in_configuration_mode_run_as_fmi2s_three_to_the_bit(
     np.testing.assert_array_equal(rows, fmi2_rows)
 
 
-def test_three_gears_in_model_exchange_have_ten_states(box3_unzipdir, box3_md, vr3):
+def test_three_gears_in_model_exchange_have_twenty_eight_states(box3_unzipdir, box3_md, vr3):
     """FMI 3.0's state vector of three gears: phi, x_omega_I, the flywheel's x_theta_F and
-    x_omega_F, the three xi, the three xi_dot, as the variables read them (the engine ramped,
-    so that every state is in use: x_omega_F at omega_F(0), its derivative alpha_F(0))."""
+    x_omega_F, the box's energies, then each array of the gears' states (xi, xi_dot, their
+    energies and window integrals) of three elements, as the variables read them (the engine
+    ramped, so that every state is in use: x_omega_F at omega_F(0), its derivative alpha_F(0);
+    the window open from the start)."""
     from ctypes import c_double
 
     fmu = configured(box3_unzipdir, box3_md, FMU3Model, "three gears ME", 3, [])
     fmu.enterInitializationMode(startTime=0.0)
-    fmu.setFloat64([vr3["rpm_rate"]], [-150.0])
+    fmu.setFloat64([vr3["rpm_rate"], vr3["stats_from"]], [-150.0, 0.0])
     fmu.exitInitializationMode()
-    assert fmu.getNumberOfContinuousStates() == 10
-    x = (c_double * 10)()
-    fmu.getContinuousStates(x, 10)
-    expected = fmu.getFloat64([vr3["phi"], vr3["x_omega_I"], vr3["x_theta_F"], vr3["x_omega_F"], vr3["gear.xi"],
-                               vr3["gear.xi_dot"]], nValues=10)
+    n = len(BOX_STATES) + 3 * len(GEAR_STATES)
+    assert fmu.getNumberOfContinuousStates() == n == 28
+    x = (c_double * n)()
+    fmu.getContinuousStates(x, n)
+    expected = fmu.getFloat64([vr3[s] for s in BOX_STATES] + [vr3[f"gear.{s}"] for s in GEAR_STATES], nValues=n)
     assert list(x) == expected
     assert x[3] == pytest.approx(800 * np.pi / 30) and x[3] == x[1]
-    dx = (c_double * 10)()
-    fmu.getContinuousStateDerivatives(dx, 10)
-    assert list(dx) == fmu.getFloat64([vr3["der(phi)"], vr3["der(x_omega_I)"], vr3["der(x_theta_F)"],
-                                       vr3["der(x_omega_F)"], vr3["der(gear.xi)"], vr3["der(gear.xi_dot)"]],
-                                      nValues=10)
+    dx = (c_double * n)()
+    fmu.getContinuousStateDerivatives(dx, n)
+    assert list(dx) == fmu.getFloat64([vr3[f"der({s})"] for s in BOX_STATES]
+                                      + [vr3[f"der(gear.{s})"] for s in GEAR_STATES], nValues=n)
+    a2 = len(BOX_STATES) + 3 * GEAR_STATES.index("int_a2")
+    assert all(d > 0 for d in dx[a2:a2 + 3])  # the window's integrand a^2, the window open
     assert dx[2] == x[3] and dx[3] == pytest.approx(-150 * np.pi / 30 + 600 + 120)
     fmu.terminate()
     fmu.freeInstance()
