@@ -110,13 +110,18 @@ pub unsafe fn slice<'a, T>(ptr: *const T, len: usize, what: &str) -> FmiResult<&
     if len == 0 {
         Ok(&[])
     } else if ptr.is_null() {
-        Err(FmiError::error(format!(
-            "{what} is NULL with {len} elements"
-        )))
+        Err(null_array(what, len))
     } else {
         // SAFETY: the caller's contract.
         Ok(unsafe { std::slice::from_raw_parts(ptr, len) })
     }
+}
+
+/// The error of a NULL array of `len` elements, out of the accepted call's path.
+#[cold]
+#[inline(never)]
+fn null_array(what: &str, len: usize) -> FmiError {
+    FmiError::error(format!("{what} is NULL with {len} elements"))
 }
 
 /// An importer's output array as a mutable slice (see [`slice`]).
@@ -127,9 +132,7 @@ pub unsafe fn slice_mut<'a, T>(ptr: *mut T, len: usize, what: &str) -> FmiResult
     if len == 0 {
         Ok(&mut [])
     } else if ptr.is_null() {
-        Err(FmiError::error(format!(
-            "{what} is NULL with {len} elements"
-        )))
+        Err(null_array(what, len))
     } else {
         // SAFETY: the caller's contract.
         Ok(unsafe { std::slice::from_raw_parts_mut(ptr, len) })

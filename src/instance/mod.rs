@@ -8,12 +8,13 @@ pub mod model_exchange;
 pub mod simulation;
 
 pub use fmi2_shell::{FmiError, FmiResult, FmiState, Status};
-pub use simulation::{Carry, Simulation};
+pub use simulation::{Carry, Readout, Simulation};
 
 use crate::contract::{self, Causality, Kind, LOG_CATEGORIES, vr};
 use crate::integrator::SolverError;
 use crate::physics::Shaft;
 use crate::rattle::Impacts;
+use fmi2_shell::values::Values;
 use fmi2_shell::{Continuous, Core, EventInfo, Identity, Interface, Model, Slave, Stepping};
 
 use serde::{Deserialize, Serialize};
@@ -47,26 +48,33 @@ impl Instance {
         ))
     }
 
-    /// A Real output of the running simulation as the interface reads it (Model Exchange:
-    /// the contact in the region ξ is in, as the derivatives).
-    fn output(sim: &Simulation, interface: Interface, vr: u32) -> Option<f64> {
-        match interface {
-            Interface::CoSimulation => sim.real_output(vr),
-            Interface::ModelExchange => sim.model_exchange_output(vr),
-        }
-    }
-
     /// A Real variable's value by its contract entry (a parameter, an input, or an output of
-    /// the simulation built from the values so far).
+    /// the simulation built from the values so far, as the interface reads it). Kept out of `get_real`'s loop: building a
+    /// simulation needs a large stack frame, which the reading of outputs after each step
+    /// would otherwise set up at every call.
+    #[inline(never)]
     fn real_value(&mut self, vr: u32) -> FmiResult<f64> {
         Ok(match contract::variable(Kind::Real, vr)?.causality {
             Causality::Output | Causality::Local => {
                 let interface = self.core.interface;
-                Self::output(self.current()?, interface, vr)
+                Readout::new(self.current()?, interface)
+                    .real(vr)
                     .expect("every computed Real variable of the contract is computed")
             }
             _ => self.core.values.real(vr),
         })
+    }
+
+    /// A Real parameter or input as set; refused if `vr` is no Real variable of the contract.
+    /// The running simulation computes every other Real variable.
+    #[inline(never)]
+    fn stored_real(values: &Values, vr: u32) -> FmiResult<f64> {
+        let var = contract::variable(Kind::Real, vr)?;
+        assert!(
+            !matches!(var.causality, Causality::Output | Causality::Local),
+            "every computed Real variable of the contract is computed"
+        );
+        Ok(values.real(vr))
     }
 
     /// After new values in `state`: rebuild the initial state during initialisation, or hand
@@ -308,16 +316,23 @@ impl Slave for Instance {
     }
 
     fn get_real(&mut self, vrs: &[u32], out: &mut [f64]) -> FmiResult {
+        let Some(sim) = &self.core.sim else {
+            // No simulation yet (initialisation): the first computed value builds it.
+            for (vr, out) in vrs.iter().zip(out) {
+                *out = self.real_value(*vr)?;
+                if !out.is_finite() {
+                    return Err(Self::not_finite(*vr, *out));
+                }
+            }
+            return Ok(());
+        };
+        // The outputs of the running simulation, what they share computed once for the call:
+        // what a master reads after each step.
+        let readout = Readout::new(sim, self.core.interface);
         for (vr, out) in vrs.iter().zip(out) {
-            // An output of the running simulation first: what a master reads after each step.
-            let output = self
-                .core
-                .sim
-                .as_ref()
-                .and_then(|sim| Self::output(sim, self.core.interface, *vr));
-            *out = match output {
+            *out = match readout.real(*vr) {
                 Some(value) => value,
-                None => self.real_value(*vr)?,
+                None => Self::stored_real(&self.core.values, *vr)?,
             };
             if !out.is_finite() {
                 return Err(Self::not_finite(*vr, *out));

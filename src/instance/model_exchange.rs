@@ -246,12 +246,7 @@ impl Simulation {
     /// them (the region kept since the last event gives another force between an edge
     /// crossing and the importer's event there).
     pub fn model_exchange_output(&self, vr: u32) -> Option<f64> {
-        self.real_output_with(
-            vr,
-            &self.now(),
-            || self.point().shaft,
-            || self.point().loads,
-        )
+        super::simulation::Readout::new(self, fmi2_shell::Interface::ModelExchange).real(vr)
     }
 
     /// The Model Exchange variables that are not outputs: the states θ_M and ω_M of the

@@ -16,12 +16,15 @@ use crate::physics::{
     Dynamics, Excitation, GearParams, Loads, MainShaft, Polynomial, Region, Shaft, Sine, TorqueRamp,
 };
 use crate::rattle::torque::{self, TorqueRattle};
-use crate::rattle::window::{Metrics, Quadratures, Window, quadrature};
+use crate::rattle::window::{Metrics, Quadratures, Window};
 use crate::rattle::{self, GearPair, Impacts, KinematicRattle, LeanRattle, Rattle};
 use fmi2_shell::values::Values;
 use journal::{Entry, Journal};
 
 mod journal;
+mod readout;
+
+pub use readout::Readout;
 
 /// Values of the `excitation` parameter.
 pub const EXCITATION_INPUTS: i64 = 0;
@@ -553,53 +556,11 @@ impl Simulation {
         Ok(t)
     }
 
-    /// The value of a Real output, computed now; None if `vr` is not a Real output.
+    /// The value of a Real output read in co-simulation, computed now; None if `vr` is not a
+    /// Real output (see [`Readout`]).
+    #[inline]
     pub fn real_output(&self, vr: u32) -> Option<f64> {
-        // ξ and ξ' straight from the state: fmi2DoStep reads them after every step.
-        match vr {
-            vr::xi => return Some(on_gear!(&self.gear, k => k.xi()[0])),
-            vr::xi_dot => return Some(on_gear!(&self.gear, k => k.xi()[1])),
-            _ => {}
-        }
-        let now = self.now();
-        self.real_output_with(vr, &now, || self.shaft(), || now.loads(&self.shaft()))
-    }
-
-    /// A Real output with the shaft's motion and the loads from `shaft` and `loads`, each
-    /// computed only for the outputs that need it (the contact law's region kept by the
-    /// integrator, or in Model Exchange the one ξ is in).
-    pub(super) fn real_output_with(
-        &self,
-        vr: u32,
-        now: &Now,
-        shaft: impl Fn() -> Shaft,
-        loads: impl Fn() -> Loads,
-    ) -> Option<f64> {
-        let dynamics = now.dynamics;
-        Some(match vr {
-            vr::theta_L => dynamics.theta_L(now.xi, &shaft()),
-            vr::omega_L => loads().omega_L,
-            vr::alpha_L => loads().alpha_L,
-            vr::a_pitch_L => dynamics.params.r_L * loads().alpha_L,
-            vr::xi => now.xi,
-            vr::xi_dot => now.xi_dot,
-            vr::F_contact => loads().force.total(),
-            vr::tau_M => dynamics.tau_M(&loads()),
-            vr::impact_speed => now.impacts.last_speed,
-            vr::E_contact => now.quadratures[quadrature::E_CONTACT],
-            vr::E_lubricant => now.quadratures[quadrature::E_LUBRICANT],
-            vr::theta_M_out => shaft().theta,
-            vr::omega_M_out => shaft().omega,
-            vr::alpha_M_out => shaft().alpha,
-            vr::solver_steps => now.stats.accepted as f64,
-            vr::solver_rejected => now.stats.rejected as f64,
-            vr::solver_rhs => now.stats.rhs_evals as f64,
-            vr::solver_implicit_steps => now.stats.implicit_steps as f64,
-            _ => {
-                return stat_real(&now.metrics(self.t), vr)
-                    .or_else(|| self.model_exchange_local(vr));
-            }
-        })
+        Readout::new(self, fmi2_shell::Interface::CoSimulation).real(vr)
     }
 
     /// First time derivative of a Real output (maxOutputDerivativeOrder = 1), from the
