@@ -2,7 +2,6 @@
 there: the steps succeed, in every mode, and the stat_* outputs are those of the window that
 opens on the communication point (tests/support/window_opening.py's master)."""
 
-
 import pytest
 
 from gearrattle import reference as R
