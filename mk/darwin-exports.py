@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Removes from the export trie of each slice of a Mach-O dylib every name but the fmi2* and fmi3*
-functions: zig's linker exports `__mh_dylib_header` and `___dso_handle` (the Mach-O header)
+functions (and fmi2-shell's sampling entry gearRattleDoStepSampled): zig's linker exports `__mh_dylib_header` and `___dso_handle` (the Mach-O header)
 from every dylib it links, which Apple's ld keeps private. mk/darwin-link.py has already
 hidden every other symbol before the link.
 
@@ -20,7 +20,7 @@ import sys
 
 FAT_MAGIC, MH_MAGIC_64 = 0xCAFEBABE, 0xFEEDFACF
 LC_DYLD_INFO, LC_DYLD_INFO_ONLY, LC_DYLD_EXPORTS_TRIE = 0x22, 0x80000022, 0x80000033
-KEEP = re.compile(r"_fmi[23]\w+")
+KEEP = re.compile(r"_(fmi[23]\w+|gearRattleDoStepSampled)")
 
 
 def read_uleb(data, at):

@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """Linker for the apple-darwin targets of `cargo zigbuild` (mk/portable.mk): hides every
-symbol but the fmi2* and fmi3* functions, then hands the link to cargo-zigbuild's `zig cc` wrapper.
+symbol but the fmi2* and fmi3* functions (and fmi2-shell's sampling entry
+gearRattleDoStepSampled), then hands the link to cargo-zigbuild's `zig cc` wrapper.
 
 Why: rustc passes the Apple linker an exported-symbols list (every #[no_mangle] function,
 fmi-sys's `callback_log` included), but zig's Mach-O linker ignores -exported_symbols_list
@@ -78,7 +79,8 @@ def main(args):
         fail("rustc's -exported_symbols_list is not among the arguments (is this a cdylib link?)")
     list_path = args[lists[0] + 1].removeprefix("-Wl,")
     with open(list_path) as f:
-        keep = [n.strip() for n in f if re.fullmatch(r"_fmi[23]\w+", n.strip())]
+        keep = [n.strip() for n in f
+                if re.fullmatch(r"_(fmi[23]\w+|gearRattleDoStepSampled)", n.strip())]
     if not keep:
         fail(f"no fmi2* or fmi3* symbol in {list_path}")
     work = os.path.dirname(list_path)  # rustc's temporary directory for this link

@@ -1,6 +1,7 @@
 #!/bin/sh
 # Linker for the x86_64-pc-windows-gnu target (set in .cargo/config.toml): MinGW-w64's gcc,
-# after narrowing rustc's export list to the fmi2* and fmi3* functions.
+# after narrowing rustc's export list to the fmi2* and fmi3* functions (and fmi2-shell's
+# sampling entry gearRattleDoStepSampled, outside FMI).
 #
 # Why: for a cdylib, rustc writes a .def file naming every #[no_mangle] symbol of every crate,
 # fmi-sys's `callback_log` included, and passes it to GNU ld as `-Wl,<tmpdir>/list.def`.
@@ -28,7 +29,7 @@ for arg in "$@"; do
             kept=${def%.def}.fmi2.def
             echo EXPORTS >"$kept"
             # An empty list would make ld export every global symbol: refuse instead.
-            if ! grep -E '^[[:space:]]*"?fmi[23]' "$def" >>"$kept"; then
+            if ! grep -E '^[[:space:]]*"?(fmi[23]|gearRattleDoStepSampled)' "$def" >>"$kept"; then
                 echo "mk/windows-link.sh: no fmi2* or fmi3* symbol in $def" >&2
                 exit 1
             fi

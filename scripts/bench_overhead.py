@@ -32,37 +32,49 @@ SAME = (["xi", "xi_dot", "solver_steps", "solver_rhs"], ["impacts_Fplus", "impac
 WINDOW = (["stat_window", "stat_a_rms", "stat_a_peak", "stat_F_std"], ["stat_impacts_Fplus"])
 
 
+def description(xml):
+    """A model description's root, GUID and variables (name: (vr, Integer))."""
+    root = ET.parse(xml).getroot()
+    variables = {v.get("name"): (int(v.get("valueReference")), v.find("Integer") is not None)
+                 for v in root.iter("ScalarVariable")}
+    return root, root.get("guid"), variables
+
+
 def library(tree):
-    """The release library of a source tree, its GUID and its variables (name: (vr, Integer))."""
+    """The release library of a source tree, its GUID and its variables."""
     lib = os.path.join(tree, "target", "release", "libgear_rattle.so")
     xmls = glob.glob(os.path.join(tree, "target", "release", "build", "gear_rattle-*", "out",
                                   "modelDescription.xml"))
     if not os.path.exists(lib) or not xmls:
         sys.exit(f"{tree}: no release build (cargo build --release --lib there)")
-    root = ET.parse(max(xmls, key=os.path.getmtime)).getroot()
-    variables = {v.get("name"): (int(v.get("valueReference")), v.find("Integer") is not None)
-                 for v in root.iter("ScalarVariable")}
-    return lib, root.get("guid"), variables
+    _, guid, variables = description(max(xmls, key=os.path.getmtime))
+    return lib, guid, variables
 
 
 def case(label, tree, start, read):
-    """The harness's input line of one case: its start values, the outputs it reads."""
-    lib, guid, variables = library(tree)
+    """The harness's input line of one case of a source tree's library."""
+    return line(label, *library(tree), start, read)
+
+
+def line(label, lib, guid, variables, start, read):
+    """The harness's input line of one case: its start values, the Real and the Integer
+    outputs it reads."""
     missing = [n for n in [*start, *read[0], *read[1]] if n not in variables]
     if missing:
-        sys.exit(f"{tree}: no {missing}")
+        sys.exit(f"{lib}: no {missing}")
     reals = [f"{variables[n][0]} {v!r}" for n, v in start.items() if not variables[n][1]]
     ints = [f"{variables[n][0]} {int(v)}" for n, v in start.items() if variables[n][1]]
-    line = [label, lib, guid, str(len(reals)), *reals, str(len(ints)), *ints]
+    words = [label, lib, guid, str(len(reals)), *reals, str(len(ints)), *ints]
     for names in read:
-        line += [str(len(names)), *(str(variables[n][0]) for n in names)]
-    return " ".join(line)
+        words += [str(len(names)), *(str(variables[n][0]) for n in names)]
+    return " ".join(words)
 
 
-def instructions(harness, line, args):
-    """Instructions executed inside fmi2DoStep by one trajectory of the case `line`."""
+def instructions(harness, line, args, functions=("fmi2DoStep",)):
+    """Instructions executed inside `functions` by one trajectory of the case `line`."""
     with tempfile.NamedTemporaryFile(suffix=".callgrind") as out:
-        subprocess.run(["valgrind", "--tool=callgrind", "--toggle-collect=fmi2DoStep",
+        collect = [f"--toggle-collect={f}" for f in functions]
+        subprocess.run(["valgrind", "--tool=callgrind", *collect,
                         f"--callgrind-out-file={out.name}", harness, "1", "1", *args],
                        input=line, capture_output=True, text=True, check=True)
         return int(re.search(r"^summary: (\d+)", open(out.name).read(), re.M).group(1))

@@ -1,17 +1,19 @@
-/* Several GearRattle FMU binaries stepped from C in one process, alternating, for
- * `make bench-overhead` (scripts/bench_overhead.py writes its input and reads its output).
+/* Several FMU binaries stepped from C in one process, alternating, for `make bench-overhead`
+ * and `make bench-percall` (scripts/bench_overhead.py and scripts/bench_percall.py write its
+ * input and read its output).
  *
- *   overhead ROUNDS REPEATS DURATION STEP TOLERANCE < cases
+ *   overhead ROUNDS REPEATS DURATION STEP TOLERANCE [each] < cases
  *
  * stdin: one line per case, "LABEL LIBRARY GUID NR vr value ... NI vr value ... NG vr ...
  * NGI vr ...": the Real and Integer start values to set, then the Real and the Integer outputs
- * to read at the end. Each
- * round runs every case REPEATS times in turn (fmi2Reset, fmi2SetupExperiment with the
- * tolerance, the start values, initialization, fmi2DoStep of STEP up to DURATION).
- * stdout: per round and case "time LABEL CPU_S" (process CPU of one trajectory, the mean over
- * the repeats), then per case "read LABEL value ..." (the Real ones %.17g, then the Integer ones, at
- * the last trajectory's end). */
+ * to read at the end. Each round runs every case REPEATS times in turn (fmi2Reset,
+ * fmi2SetupExperiment with the tolerance, the start values, initialization, fmi2DoStep of STEP
+ * up to DURATION; with `each`, fmi2GetReal of the Real outputs after every fmi2DoStep, as an
+ * importer reads them). stdout: per round and case "time LABEL CPU_S" (process CPU of one
+ * trajectory, the mean over the repeats), then per case "read LABEL value ..." (the Real ones
+ * %.17g, then the Integer ones, at the last trajectory's end). */
 #include "fmi2_calls.h"
+#include <string.h>
 
 typedef struct {
     char label[64];
@@ -57,12 +59,15 @@ static int read_case(Case *k) {
 
 /* One trajectory; the communication points are counted, not summed, so that every binary
  * sees the same times. */
-static void run(Case *k, double duration, double h, double tol) {
+static void run(Case *k, double duration, double h, double tol, int each) {
     long n = (long)(duration / h + 0.5);
     int bad = k->reset(k->c) || k->setup(k->c, 1, tol, 0.0, 1, duration)
               || k->set_real(k->c, k->rv, k->nr, k->r) || k->set_int(k->c, k->iv, k->ni, k->i)
               || k->enter(k->c) || k->leave(k->c);
-    for (long j = 0; j < n && !bad; j++) bad = k->step(k->c, j * h, h, 1);
+    for (long j = 0; j < n && !bad; j++) {
+        bad = k->step(k->c, j * h, h, 1);
+        if (each && !bad) bad = k->get_real(k->c, k->gv, k->ng, k->g);
+    }
     if (bad || k->get_real(k->c, k->gv, k->ng, k->g) || k->get_int(k->c, k->giv, k->ngi, k->gi)) {
         fprintf(stderr, "%s: refused\n", k->label);
         exit(1);
@@ -70,8 +75,9 @@ static void run(Case *k, double duration, double h, double tol) {
 }
 
 int main(int argc, char **argv) {
-    if (argc != 6) {
-        fprintf(stderr, "usage: overhead ROUNDS REPEATS DURATION STEP TOLERANCE < cases\n");
+    int each = argc == 7 && !strcmp(argv[6], "each");
+    if (argc != 6 && !each) {
+        fprintf(stderr, "usage: overhead ROUNDS REPEATS DURATION STEP TOLERANCE [each] < cases\n");
         return 2;
     }
     int rounds = atoi(argv[1]), repeats = atoi(argv[2]);
@@ -82,7 +88,7 @@ int main(int argc, char **argv) {
     for (int r = 0; r < rounds; r++) {
         for (int k = 0; k < n; k++) {
             double t0 = cpu();
-            for (int j = 0; j < repeats; j++) run(&cases[k], duration, h, tol);
+            for (int j = 0; j < repeats; j++) run(&cases[k], duration, h, tol, each);
             printf("time %s %.9f\n", cases[k].label, (cpu() - t0) / repeats);
         }
     }

@@ -864,7 +864,9 @@ fn rust(c: &Contract, guid: &str) -> String {
     r
 }
 
-/// Keeps the shared library's exports to the FMI functions: a cdylib otherwise exports every
+/// Keeps the shared library's exports to the FMI functions and the sampling entry
+/// `gearRattleDoStepSampled` (`fmu::sampled`, outside FMI; the platforms' filters in mk/ keep
+/// it too): a cdylib otherwise exports every
 /// `#[no_mangle]` symbol of its dependencies too (fmi-sys brings `callback_log`). rustc's own
 /// version script names those symbols as global, and GNU ld lets an explicit name win over
 /// our wildcard, so the one fmi-sys brings is named here (a test checks the export table).
@@ -888,7 +890,7 @@ pub fn restrict_exports() {
     let script = out.join("exports.map");
     fs::write(
         &script,
-        "{\n  global: fmi2*; fmi3*;\n  local: callback_log; *;\n};\n",
+        "{\n  global: fmi2*; fmi3*; gearRattleDoStepSampled;\n  local: callback_log; *;\n};\n",
     )
     .unwrap();
     println!(

@@ -12,6 +12,8 @@ use crate::time;
 use crate::values::Starts;
 use serde::{Deserialize, Serialize};
 
+mod sampled;
+
 /// The FMI state, the times and the slave. All of it is the FMU state (fmi2GetFMUstate)
 /// except the slave's queued log lines.
 #[derive(Clone, Debug, Serialize, Deserialize)]

@@ -130,6 +130,16 @@ macro_rules! export_co_simulation {
             fn fmi2DoStep(currentCommunicationPoint: fmi2Real, communicationStepSize: fmi2Real,
                 _noSetFMUStatePriorToCurrentPoint: fmi2Boolean)
                 DO_STEP |s| s.do_step(currentCommunicationPoint, communicationStepSize);
+            // Outside FMI: nSamples steps of sampleInterval, the Real variables vr read after
+            // each into values (nSamples rows of nvr), in one call (fmu::sampled).
+            fn gearRattleDoStepSampled(currentCommunicationPoint: fmi2Real, sampleInterval: fmi2Real,
+                nSamples: usize, vr: *const fmi2ValueReference, nvr: usize, values: *mut fmi2Real)
+                DO_STEP |s| {
+                    let len = nSamples.checked_mul(nvr).ok_or_else(|| FmiError::error(format!(
+                        "nSamples = {nSamples} rows of nvr = {nvr} values overflow")))?;
+                    s.do_step_sampled(currentCommunicationPoint, sampleInterval, nSamples,
+                        array!(vr, nvr), array!(mut values, len))
+                };
             fn fmi2CancelStep() CANCEL_STEP |_| Ok(());
             fn fmi2GetStatus(kind: fmi2StatusKind, _value: *mut fmi2Status)
                 GET_STATUS |_| e::unavailable(kind);

@@ -202,13 +202,17 @@ impl Slave for Instance {
 
     fn get_real(&mut self, vrs: &[u32], out: &mut [f64]) -> FmiResult {
         self.build_if_computed(Kind::Real, vrs)?;
-        let now = self.core.sim.as_ref().map(Now::new);
+        // The readout once for the call, where a variable needs more than a contact force.
+        let sim = self.core.sim.as_ref();
+        let now = std::cell::OnceCell::new();
         for (vr, out) in vrs.iter().zip(out) {
             let var = contract::variable(Kind::Real, *vr)?;
             *out = match var.causality {
-                Causality::Output | Causality::Local => now
-                    .as_ref()
-                    .and_then(|now| now.real(*vr))
+                Causality::Output | Causality::Local => sim
+                    .and_then(|sim| {
+                        sim.contact_force(*vr)
+                            .or_else(|| now.get_or_init(|| Now::new(sim)).real(*vr))
+                    })
                     .expect("every computed Real variable of the contract is computed"),
                 _ => self.core.values.real(*vr),
             };

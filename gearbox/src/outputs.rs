@@ -7,7 +7,7 @@ use crate::contract::vr::{self, gear::offset};
 use crate::contract::{DERIVATIVES, STATES};
 use crate::simulation::Simulation;
 use fmi2_shell::Continuous;
-use gear_rattle::gearbox::{Gearbox, Readout};
+use gear_rattle::gearbox::{Gearbox, Readout, xi, xi_dot};
 use gear_rattle::rattle::window::Metrics;
 
 /// What the outputs are computed from now: the gearbox's readout, once for every output read
@@ -129,6 +129,26 @@ impl Simulation {
     /// The value of a Real output or local, computed now; None if `vr` is none.
     pub fn real_output(&self, vr: u32) -> Option<f64> {
         Now::new(self).real(vr)
+    }
+
+    /// Gear i's contact force F_contact from the gearbox's state alone, the value [`Now`]
+    /// reads without the rest of the readout (the other loads, the flywheel's motion): what
+    /// the sound reads at every sample (docs/SOUND.md, "The force"). None for any other
+    /// variable, and in Model Exchange, where the outputs read the settled regions.
+    pub fn contact_force(&self, vr: u32) -> Option<f64> {
+        let (i, offset) = vr::gear::locate(vr)?;
+        if offset != offset::F_contact || self.model_exchange {
+            return None;
+        }
+        let (gearbox, y) = self.gearbox();
+        Some(match gearbox.gears[..gearbox.n_gears()].get(i) {
+            Some(g) => g
+                .dynamics
+                .law
+                .force(g.region, y[xi(i)], y[xi_dot(i)])
+                .total(),
+            None => 0.0,
+        })
     }
 
     /// The Model Exchange variables that are not outputs: the state x_omega_I and the
@@ -267,4 +287,52 @@ fn stat_integer(m: Option<&Metrics>, offset: u32) -> Option<i64> {
         stat_regime => regime,
         _ => side,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::contract::{Kind, vr};
+    use crate::instance::Instance;
+    use crate::outputs::Now;
+    use fmi2_shell::{Fmu, Interface};
+
+    /// The contact force read alone is the readout's, to the bit, for every gear slot at
+    /// every point of a fine grid through the start-up's impacts (none in Model Exchange,
+    /// whose outputs read the settled regions).
+    #[test]
+    fn contact_force_alone_is_the_readouts() {
+        std::thread::Builder::new()
+            .stack_size(8 << 20)
+            .spawn(|| {
+                let mut fmu = Fmu::<Instance>::new(false, Interface::CoSimulation);
+                fmu.set_integer(&[vr::excitation], &[1]).unwrap();
+                fmu.enter_initialization_mode().unwrap();
+                fmu.exit_initialization_mode().unwrap();
+                let forces: Vec<u32> = crate::contract::VARIABLES
+                    .iter()
+                    .filter(|v| v.kind == Kind::Real && v.name.ends_with(".F_contact"))
+                    .map(|v| v.vr)
+                    .collect();
+                assert_eq!(forces.len(), gear_rattle::gearbox::MAX_GEARS);
+                let (h, mut in_contact) = (1.0 / 192_000.0, 0);
+                for k in 0..3840 {
+                    fmu.do_step(k as f64 * h, h).unwrap();
+                    let sim = fmu.slave.simulation().unwrap();
+                    for &vr in &forces {
+                        let alone = sim.contact_force(vr).unwrap();
+                        assert_eq!(alone.to_bits(), Now::new(sim).real(vr).unwrap().to_bits());
+                        in_contact += usize::from(alone != 0.0);
+                    }
+                }
+                assert!(in_contact > 100, "{in_contact} samples in contact");
+                let mut me = Fmu::<Instance>::new(false, Interface::ModelExchange);
+                me.enter_initialization_mode().unwrap();
+                me.exit_initialization_mode().unwrap();
+                let sim = me.slave.simulation().unwrap();
+                assert!(sim.contact_force(forces[0]).is_none());
+            })
+            .unwrap()
+            .join()
+            .unwrap();
+    }
 }

@@ -80,10 +80,35 @@ def reads_alone(unzipdir, md, values, n):
     return cpu
 
 
+def sampled_alone(unzipdir, md, values, duration, read):
+    """CPU of meshes.record's calls of the FMU's sampling entry over duration (CHUNK each),
+    reading the forces at every point if `read`, else none: the FMU's part of the stepping.
+    None where the FMU does not export the entry."""
+    from .meshes import CHUNK, FS, SUBSAMPLE, _sampled_call, meshes
+
+    ms = meshes(md, values) if read else []
+    inst = _initialised(unzipdir, md, values)
+    call = _sampled_call(inst)
+    if call is None:
+        _free(inst)
+        return None
+    h = 1.0 / (FS * SUBSAMPLE)
+    n, every = int(round(duration / h)), int(round(CHUNK / h))
+    vr = (ctypes.c_uint * max(1, len(ms)))(*[m.force.valueReference for m in ms])
+    F = np.zeros((every, len(ms)))
+    comp, vr_at, f_at = inst.component, ctypes.addressof(vr), F.ctypes.data
+    t0 = time.process_time()
+    for k in range(0, n, every):
+        call(comp, k * h, h, min(every, n - k), vr_at, len(ms), f_at)
+    cpu = time.process_time() - t0
+    _free(inst)
+    return cpu
+
+
 def cost(fmu, unzip, md, values, duration):
     """Print the CPU of the simulation alone, of the WAV (the forces sampled, filtered, the mix
     and stems written) and of the metrics, best of 3 for the first two."""
-    from .meshes import SUBSAMPLE, simulate
+    from .meshes import CHUNK, SAMPLED, SUBSAMPLE, simulate
     from .metrics import full_scale, metrics, write_wav
     from .modal import ModalTransfer
     from .render import render
@@ -104,8 +129,13 @@ def cost(fmu, unzip, md, values, duration):
           f"{duration:g} s simulated, {len(run.forces)} meshes, default modal housing; CPU s")
     print(f"  {'simulation alone':>16s} {'WAV':>8s} {'ratio':>7s}   {'of the WAV: stepping':>20s} "
           f"{'filtering':>9s}   {'metrics':>8s}")
-    print(f"  {t_alone:16.3f} {t_wav:8.3f} {t_wav / t_alone:6.0f}x   {run.cpu_s:20.3f} "
+    print(f"  {t_alone:16.3f} {t_wav:8.3f} {t_wav / t_alone:6.1f}x   {run.cpu_s:20.3f} "
           f"{snd.cpu_s:9.3f}   {t_met:8.3f}")
+    steps = min(sampled_alone(unzip, md, values, duration, False) or 0 for _ in range(3))
+    if steps:
+        read = min(sampled_alone(unzip, md, values, duration, True) for _ in range(3))
+        print(f"  of the stepping, inside the FMU ({SAMPLED}, {CHUNK * 1e3:g} ms a call): the "
+              f"steps alone {steps:.3f}, with the forces read at each point {read:.3f}")
 
 
 def main(argv=None):
@@ -113,7 +143,7 @@ def main(argv=None):
     from fmpy import extract, read_model_description
 
     from ..study.spec import parse_set
-    from .meshes import SUBSAMPLE, simulate, start_values
+    from .meshes import SAMPLED, SUBSAMPLE, simulate, start_values
     from .metrics import full_scale, metrics, write_wav
     from .modal import ModalTransfer
     from .render import render
@@ -149,10 +179,17 @@ def main(argv=None):
               f"{np.sqrt(np.mean(e ** 2) / np.mean(p_ref ** 2)):9.1e}{mark}")
         if sub == SUBSAMPLE:
             mix, steps, t_grid = snd.mix, run.steps, t_sim
-    t_reads = min(reads_alone(unzip, md, values, steps) for _ in range(3))
-    print(f"  of the simulation at subsample {SUBSAMPLE} ({t_grid:.3f} s, {steps} steps): the "
-          f"reads from Python {t_reads:.3f} s; the rest, fmi2DoStep from Python, "
-          f"{(t_grid - t_reads) / steps * 1e6:.2f} us a step")
+    t_steps = min(sampled_alone(unzip, md, values, a.duration, False) or 0 for _ in range(3))
+    if t_steps:
+        t_read = min(sampled_alone(unzip, md, values, a.duration, True) for _ in range(3))
+        print(f"  of the simulation at subsample {SUBSAMPLE} ({t_grid:.3f} s, {steps} steps): "
+              f"inside the FMU ({SAMPLED}) the steps alone {t_steps:.3f} s, with the forces "
+              f"read at each {t_read:.3f} s")
+    else:
+        t_reads = min(reads_alone(unzip, md, values, steps) for _ in range(3))
+        print(f"  of the simulation at subsample {SUBSAMPLE} ({t_grid:.3f} s, {steps} steps): "
+              f"the reads from Python {t_reads:.3f} s; the rest, fmi2DoStep from Python, "
+              f"{(t_grid - t_reads) / steps * 1e6:.2f} us a step")
     with tempfile.TemporaryDirectory() as d:
         t_wav, _ = _cpu(write_wav, os.path.join(d, "x.wav"), mix, full_scale(mix))
     t_met, m = _cpu(metrics, mix)

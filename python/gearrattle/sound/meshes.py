@@ -7,7 +7,8 @@ counters `<prefix>impacts_Fplus` and `<prefix>impacts_Fminus` when the FMU has t
 the force's onsets (F leaving zero).
 
 The FMU is stepped on the grid t_n = n h, h = 1 / (48 kHz · SUBSAMPLE): every SUBSAMPLE-th
-sample is a sample of the WAV, so the pressure at the WAV's instants needs no resampling."""
+sample is a sample of the WAV, so the pressure at the WAV's instants needs no resampling. Where
+the FMU's binary has the sampling entry SAMPLED, a chunk of the grid is one call."""
 
 from dataclasses import dataclass
 import re
@@ -18,6 +19,10 @@ import numpy as np
 from .metrics import FS
 
 SUBSAMPLE = 4  # force samples per WAV sample: h = 5.2 µs (docs/SOUND.md, "Error")
+# The FMU's export that takes a run of steps and reads the forces at each in one call
+# (fmi2-shell's, outside FMI), and the simulated time of one such call [s].
+SAMPLED = "gearRattleDoStepSampled"
+CHUNK = 0.01
 FORCE = "F_contact"
 COUNTERS = ("impacts_Fplus", "impacts_Fminus")
 # Start values that make a lone FMU run the paper's bench (the FMU's defaults are scene S1).
@@ -126,9 +131,14 @@ def simulate(fmu, md, values, duration, t_record=0.0, subsample=SUBSAMPLE):
 
 def record(inst, ms, t0, t_end, subsample=SUBSAMPLE):
     """Step an initialised instance from t0 to t_end on the grid t0 + n h, reading the forces
-    at every point (straight into the result's memory) and the impact counters at the WAV's
-    samples; an impact is then placed at its force's onset within that sample interval. The
-    raw FMI calls on arrays made once keep Python's cost to about a µs a step."""
+    at every point and the impact counters between reads;
+    an impact is then placed at its force's onset within that interval.
+
+    Where the FMU's binary exports SAMPLED (docs/SOUND.md, "The force"), each CHUNK of the
+    run is one call that takes its steps and reads the forces at each, and the counters are
+    read at the chunks' ends; else fmi2DoStep and fmi2GetReal are called at every point and
+    the counters at every WAV sample. The raw FMI calls on arrays made once keep Python's
+    cost to about a µs a call."""
     import ctypes
 
     h = 1.0 / (FS * subsample)
@@ -138,31 +148,41 @@ def record(inst, ms, t0, t_end, subsample=SUBSAMPLE):
     counted = [j for j, x in enumerate(ms) if x.counters]
     vr_c = (ctypes.c_uint * (2 * len(counted)))(
         *[c.valueReference for j in counted for c in ms[j].counters])
-    F = np.zeros((n + 1, m))
-    at = np.unique(np.r_[np.arange(0, n + 1, subsample), n])  # where the counters are read
-    C = np.zeros((len(at), len(vr_c)), dtype=np.int32)  # fmi2Integer
+    F = np.zeros((m, n + 1))  # each mesh's force contiguous, for the filters
     do_step, get_real, get_int = _raw_calls(inst)
+    sampled = _sampled_call(inst)
+    every = max(1, int(round(CHUNK / h))) if sampled else subsample
+    at = np.unique(np.r_[np.arange(0, n + 1, every), n])  # where the counters are read
+    C = np.zeros((len(at), len(vr_c)), dtype=np.int32)  # fmi2Integer
+    rows = np.zeros((every, m))  # the forces between two counter reads, as the FMU writes them
     comp, row, ends = inst.component, 8 * m, at.tolist()
-    f_at, c_at = F.ctypes.data, C.ctypes.data
+    r_at, c_at = rows.ctypes.data, C.ctypes.data
     vf, vc, n_c = ctypes.addressof(vr_f), ctypes.addressof(vr_c), len(vr_c)  # (arrays kept)
-    get_real(comp, vf, m, f_at)
+    get_real(comp, vf, m, r_at)
+    F[:, 0] = rows[0]
     if counted:
         get_int(comp, vc, n_c, c_at)
     for i in range(1, len(ends)):
-        for k in range(ends[i - 1] + 1, ends[i] + 1):
-            status = do_step(comp, t0 + (k - 1) * h, h, 1)
-            if status != 0:
-                raise RuntimeError(f"fmi2DoStep at t = {t0 + (k - 1) * h:.9g} s returned "
-                                   f"status {status}")
-            get_real(comp, vf, m, f_at + row * k)
+        k0, k1 = ends[i - 1], ends[i]
+        if sampled:
+            _ok(sampled(comp, t0 + k0 * h, h, k1 - k0, vf, m, r_at), SAMPLED, t0 + k0 * h)
+        else:
+            for k in range(k0 + 1, k1 + 1):
+                _ok(do_step(comp, t0 + (k - 1) * h, h, 1), "fmi2DoStep", t0 + (k - 1) * h)
+                get_real(comp, vf, m, r_at + row * (k - k0 - 1))
+        F[:, k0 + 1:k1 + 1] = rows[:k1 - k0].T
         if counted:
             get_int(comp, vc, n_c, c_at + 4 * n_c * i)
-    impacts = [_from_force(F[:, j], t0, h) for j in range(m)]
     C = C.astype(np.int64)
+    impacts = [None if x.counters else _from_force(F[j], t0, h) for j, x in enumerate(ms)]
     for col, j in enumerate(counted):
-        impacts[j] = _from_counters(at, C[:, 2 * col], C[:, 2 * col + 1], F[:, j], t0, h)
-    return Run(h=h, t0=t0, forces=[F[:, j].copy() for j in range(m)], impacts=impacts,
-               meshes=ms, values={}, steps=n)
+        impacts[j] = _from_counters(at, C[:, 2 * col], C[:, 2 * col + 1], F[j], t0, h)
+    return Run(h=h, t0=t0, forces=list(F), impacts=impacts, meshes=ms, values={}, steps=n)
+
+
+def _ok(status, name, t):
+    if status != 0:
+        raise RuntimeError(f"{name} at t = {t:.9g} s returned status {status}")
 
 
 def _raw_calls(inst):
@@ -172,27 +192,49 @@ def _raw_calls(inst):
     import ctypes
 
     P = ctypes.c_void_p
+    return (_bare(inst, "fmi2DoStep", P, ctypes.c_double, ctypes.c_double, ctypes.c_int),
+            _bare(inst, "fmi2GetReal", P, P, ctypes.c_size_t, P),
+            _bare(inst, "fmi2GetInteger", P, P, ctypes.c_size_t, P))
 
-    def bare(name, *args):
-        return ctypes.CFUNCTYPE(ctypes.c_int, *args)(
-            ctypes.cast(getattr(inst.dll, name), P).value)
 
-    return (bare("fmi2DoStep", P, ctypes.c_double, ctypes.c_double, ctypes.c_int),
-            bare("fmi2GetReal", P, P, ctypes.c_size_t, P),
-            bare("fmi2GetInteger", P, P, ctypes.c_size_t, P))
+def _sampled_call(inst):
+    """The FMU's SAMPLED (component, t, dt, nSamples, vr, nvr, values) as a bare ctypes
+    function, or None where its binary does not export it."""
+    import ctypes
+
+    P = ctypes.c_void_p
+    if not hasattr(inst.dll, SAMPLED):
+        return None
+    return _bare(inst, SAMPLED, P, ctypes.c_double, ctypes.c_double, ctypes.c_size_t, P,
+                 ctypes.c_size_t, P)
+
+
+def _bare(inst, name, *args):
+    import ctypes
+
+    return ctypes.CFUNCTYPE(ctypes.c_int, *args)(
+        ctypes.cast(getattr(inst.dll, name), ctypes.c_void_p).value)
 
 
 def _from_counters(at, n_plus, n_minus, F, t0, h):
-    """The impacts the counters read at the grid indices `at` show, each placed at the force's
-    first onset in its reading interval (the whole interval when the force shows none)."""
+    """The impacts the counters read at the grid indices `at` show, placed at the force's
+    onsets in their reading interval: the i-th impact of a flank at the i-th onset of that
+    flank's sign (F+ pushes, F > 0; F- pulls, F < 0), the last such onset when the counters
+    show more, any onset when none has that sign, the whole interval when the force shows
+    none."""
     onsets = np.nonzero((F[:-1] == 0) & (F[1:] != 0))[0] + 1
     rows = []
-    for flank, c in ((1, n_plus), (2, n_minus)):
+    for flank, c, sign in ((1, n_plus, 1.0), (2, n_minus, -1.0)):
         for i in np.nonzero(np.diff(c) > 0)[0]:
             lo, hi = at[i], at[i + 1]
-            inside = onsets[(onsets > lo) & (onsets <= hi)]
-            k_lo, k_hi = (inside[0] - 1, inside[0]) if len(inside) else (lo, hi)
-            rows += [(t0 + k_lo * h, t0 + k_hi * h, flank)] * int(c[i + 1] - c[i])
+            a, b = np.searchsorted(onsets, [lo, hi], "right")
+            inside = onsets[a:b]
+            signed = inside[np.sign(F[inside]) == sign]
+            inside = signed if len(signed) else inside
+            for q in range(int(c[i + 1] - c[i])):
+                k = inside[min(q, len(inside) - 1)] if len(inside) else None
+                rows.append((t0 + (k - 1) * h, t0 + k * h, flank) if k is not None
+                            else (t0 + lo * h, t0 + hi * h, flank))
     rows.sort()
     return np.array(rows, dtype=float).reshape(-1, 3)
 

@@ -11,14 +11,16 @@ a lightly damped housing mode seen through its surface velocity. p is the sum ov
 modes of each H_ik applied to F_i.
 
 Each mode is discretised exactly for a force that is linear between its samples (first-order
-hold, FOH): the recursion reproduces the continuous response to the piecewise-linear force at
-every sample, so the only error is the force's deviation from its linear interpolant,
+hold, FOH), as one complex first-order recursion (the mode's pole), run at the WAV's rate on
+the force samples of each WAV interval: it reproduces the continuous response to the
+piecewise-linear force at every kept sample, so the only error is the force's deviation from
+its linear interpolant,
 |F − F_lin| ≤ h²/8 · max|F''|, filtered by the mode (docs/SOUND.md, "Error")."""
 
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.signal import cont2discrete, lfilter, lfilter_zi, ss2tf
+from scipy.signal import lfilter, lfiltic
 
 
 @dataclass(frozen=True)
@@ -51,17 +53,47 @@ DEFAULT_MODES = (
 )
 
 
-def foh_coefficients(mode, h):
-    """(b, a) of the FOH recursion of a mode with unit gain at the sample interval h [s]:
-    p[n] = b0 F[n] + b1 F[n−1] + b2 F[n−2] − a1 p[n−1] − a2 p[n−2]."""
+def foh_recursion(mode, h, decimate=1):
+    """The FOH recursion of a mode with unit gain at the sample interval h [s], kept at every
+    `decimate`-th sample: the mode's complex state x (x' = s1 x + F, p = 2 Re(r x)) obeys
+
+        x[n + D] = lam x[n] + sum_j c[j] F[n + j],   j = 0 .. D,   lam = exp(s1 h D)
+
+    exactly for a force linear between its samples. Returns (lam, c, r, s1)."""
+    s1 = mode.poles()[0]
     w = 2 * np.pi * mode.f
-    A = np.array([[0.0, 1.0], [-w * w, -2 * mode.zeta * w]])
-    B = np.array([[0.0], [1.0]])
-    C = np.array([[0.0, 2 * mode.zeta * w]])
-    D = np.array([[0.0]])
-    Ad, Bd, Cd, Dd, _ = cont2discrete((A, B, C, D), h, method="foh")
-    b, a = ss2tf(Ad, Bd, Cd, Dd)
-    return np.ravel(b), np.ravel(a)
+    r = 2 * mode.zeta * w * s1 / (s1 - np.conj(s1))
+    e = np.exp(s1 * h)
+    # one interval: x[n+1] = e x[n] + b0 F[n] + b1 F[n+1] (F linear in between)
+    b0 = e / s1 - (e - 1) / (s1 * s1 * h)
+    b1 = -1 / s1 + (e - 1) / (s1 * s1 * h)
+    D = decimate
+    c = np.zeros(D + 1, dtype=complex)
+    for j in range(D):
+        c[j] += e ** (D - 1 - j) * b0
+        c[j + 1] += e ** (D - 1 - j) * b1
+    return e ** D, c, r, s1
+
+
+def _real_part(recursion, shifted, F0):
+    """Re(r x[m]) for m = 0 .. M of a mode's recursion (lam, c, r, s1) driven by the shifted
+    force samples, x[0] = −F0/s1 (the state under the constant force F0), as one real
+    second-order recursion: Re(r x) has the poles lam and conj(lam), so it is
+    A(z) = 1 − 2 Re(lam) z⁻¹ + |lam|² z⁻² applied to Re(r (1 − conj(lam) z⁻¹) u), u the
+    complex input sum_j c[j] F[m D + j], plus the free response of x[0] (as initial
+    conditions)."""
+    lam, c, r, s1 = recursion
+    u_re = np.zeros(len(shifted[0]) + 1)
+    u_im = np.zeros(len(shifted[0]) + 1)
+    for cj, fj in zip(c, shifted):
+        u_re[1:] += cj.real * fj
+        u_im[1:] += cj.imag * fj
+    rl = r * np.conj(lam)
+    v = r.real * u_re - r.imag * u_im
+    v[1:] -= rl.real * u_re[:-1] - rl.imag * u_im[:-1]
+    a = [1.0, -2 * lam.real, abs(lam) ** 2]
+    w = r * (-F0 / s1)  # Re(w lam^m), m = -1, -2: the free response before the start
+    return lfilter([1.0], a, v, zi=lfiltic([1.0], a, [(w / lam).real, (w / lam ** 2).real]))[0]
 
 
 class ModalTransfer:
@@ -79,24 +111,29 @@ class ModalTransfer:
                 raise ValueError(f"the mode at {m.f:g} Hz has {len(m.gains)} gains for "
                                  f"{n_meshes} meshes: give one gain (all meshes) or one per mesh")
 
-    def pressure(self, force, mesh, h):
+    def pressure(self, force, mesh, h, decimate=1):
         """The pressure [Pa] of one mesh's force samples F[n] = F(n h), the force before F[0]
         held at F[0]: the housing starts deflected by it and silent (H(0) = 0), as when a
-        recording starts while a gear rests on its flank."""
+        recording starts while a gear rests on its flank. Kept at every `decimate`-th sample
+        (F[0], F[D], ...), each mode run at that rate on the D + 1 force samples of each of its
+        intervals: one recursion over the kept samples instead of D."""
         force = np.asarray(force, dtype=float)
-        p = np.zeros_like(force)
+        D = decimate
+        M = (len(force) - 1) // D  # intervals of D samples
+        p = np.zeros(M + 1)
+        # F[m D + j] for m = 0 .. M − 1, one array for each j = 0 .. D
+        shifted = [force[j:j + M * D:D] for j in range(D + 1)]
         for m in self.modes:
             g = m.gain(mesh)
             if g:
-                b, a = foh_coefficients(m, h)
-                p += g * lfilter(b, a, force, zi=lfilter_zi(b, a) * force[:1])[0]
+                p += 2 * g * _real_part(foh_recursion(m, h, D), shifted, force[0])
         return p
 
     def render(self, force, mesh, subsample):
         """The pressure at the WAV's instants (every subsample-th force sample)."""
         from .metrics import FS
 
-        return self.pressure(force, mesh, 1.0 / (FS * subsample))[::subsample]
+        return self.pressure(force, mesh, 1.0 / (FS * subsample), subsample)
 
     def describe(self):
         return "modal housing: " + ", ".join(
