@@ -16,7 +16,7 @@ use gear_rattle::integrator::{Method, Solver, SolverError, Stats};
 use gear_rattle::physics::{
     DamperParams, Engine, EngineOrder, EngineParams, GearParams, Oil, Polynomial, Shaft,
 };
-use gear_rattle::rattle::window::{Quadratures, Window};
+use gear_rattle::rattle::window::{self, Quadratures, Window};
 
 /// Values of the `excitation` parameter.
 pub const EXCITATION_FLYWHEEL: i64 = 0;
@@ -225,22 +225,25 @@ impl Simulation {
         self.run = Run::Windowed(Box::new(Stepped { system, solver, y }));
     }
 
-    /// Advances to t_end, through the window's opening on the way, with `at_impact` stopping
-    /// at the first impact (contact onset) of any gear on the way, where the integrator
-    /// locates it ([`Solver::advance_until`]); returns the time reached. On failure the
-    /// simulation is left as it was.
+    /// Advances to t_end, through the window's opening on the way (on the call's start or
+    /// end where it lies within the resolution of time of them: [`window::opening`]), with
+    /// `at_impact` stopping at the first impact (contact onset) of any gear on the way, where
+    /// the integrator locates it ([`Solver::advance_until`]); returns the time reached. On
+    /// failure the simulation is left as it was.
     pub fn step_until(&mut self, t_end: f64, at_impact: bool) -> Result<f64, SolverError> {
-        let stopped = if matches!(self.run, Run::Lean(_)) && self.window_from <= t_end {
+        let opening = match self.run {
+            Run::Lean(_) => window::opening(self.window_from, self.t, t_end),
+            _ => None,
+        };
+        let stopped = if let Some(from) = opening {
             let before = self.clone();
-            let advanced = self
-                .advance_until(self.window_from, at_impact)
-                .and_then(|stopped| {
-                    if stopped {
-                        return Ok(true);
-                    }
-                    self.open_window();
-                    self.advance_until(t_end, at_impact)
-                });
+            let advanced = self.advance_until(from, at_impact).and_then(|stopped| {
+                if stopped {
+                    return Ok(true);
+                }
+                self.open_window();
+                self.advance_until(t_end, at_impact)
+            });
             advanced.inspect_err(|_| *self = before)?
         } else {
             self.advance_until(t_end, at_impact)?

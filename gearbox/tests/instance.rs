@@ -284,3 +284,76 @@ fn corrupt_or_inconsistent_states_are_refused() {
         );
     });
 }
+
+/// The window at 0.03 s and a master stepping 0.029 + 1e-3 (one ulp past it), or at two ulps
+/// past that end: it opens within the resolution of time of the step's end, so it opens
+/// there. The flywheel driven by inputs (the idle engine's motion), the engine (DOPRI5 and
+/// Radau IIA) and the input side imposed (its gears stepped apart), with steps ended at each
+/// impact too (FMI 3.0's early return): every step succeeds, and each gear's window and
+/// quadratures equal those of the run whose window opens on the communication point, to
+/// the last bit, with impacts counted in it.
+#[test]
+fn a_window_within_rounding_of_a_step_end_opens_there() {
+    use gear_rattle::physics::{Engine, EngineParams, Shaft};
+    use gearbox_rattle::simulation::Simulation;
+    with_stack(|| {
+        let ulps = |x: f64, n: i64| f64::from_bits((x.to_bits() as i64 + n) as u64);
+        let t_end = 0.029 + 1e-3;
+        let engine = Engine::new(&EngineParams::idle());
+        let w = 2.0 * std::f64::consts::PI * 26.7;
+        let input_side = |t: f64| Shaft {
+            theta: 84.0 * t + 600.0 / (w * w) * (w * t).sin(),
+            omega: 84.0 + 600.0 / w * (w * t).cos(),
+            alpha: -600.0 * (w * t).sin(),
+        };
+        let run = |(excitation, solver): (i64, i64), stats_from: f64, at_impact: bool| {
+            let mut values = fmi2_shell::values::Values::start(VARIABLES);
+            values.set_integer(vr::excitation, excitation);
+            values.set_integer(vr::solver, solver);
+            values.set_integer(vr::n_gears, 3);
+            values.set_real(vr::omega_I, 84.0);
+            let flywheel = engine.steady_at(0.0).unwrap();
+            for (vr, value) in [
+                (vr::theta_F, flywheel.theta),
+                (vr::omega_F, flywheel.omega),
+                (vr::alpha_F, flywheel.alpha),
+                (vr::stats_from, stats_from),
+            ] {
+                values.set_real(vr, value);
+            }
+            let mut sim = Simulation::new(&values, 0.0, 1e-6, false).unwrap();
+            let points = (0..20).map(|k| k as f64 * 1e-3);
+            for t in points.chain((0..40).map(|k| 0.02 + k as f64 * 1e-3)) {
+                let h = 1e-3;
+                // From the master's communication point, as the instance steps; each
+                // drive takes its own inputs.
+                sim.t = t;
+                sim.set_flywheel(engine.steady_at(t).unwrap());
+                sim.set_input_side(input_side(t));
+                while sim.step_until(t + h, at_impact).unwrap() < t + h {}
+            }
+            (0..3)
+                .map(|i| {
+                    sim.window(i)
+                        .map(|(window, q)| (*window, q.map(f64::to_bits)))
+                })
+                .collect::<Vec<_>>()
+        };
+        for case in [(0, 0), (1, 0), (1, 2), (2, 0)] {
+            for at_impact in [false, true] {
+                let on_the_point = run(case, t_end, at_impact);
+                let impacts: u64 = on_the_point
+                    .iter()
+                    .map(|w| w.unwrap().0.flanks.iter().map(|f| f.impacts).sum::<u64>())
+                    .sum();
+                assert!(impacts > 0, "{case:?}");
+                for from in [0.03, ulps(t_end, 2)] {
+                    assert!(
+                        run(case, from, at_impact) == on_the_point,
+                        "{case:?} {from}"
+                    );
+                }
+            }
+        }
+    });
+}

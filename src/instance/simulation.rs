@@ -16,7 +16,7 @@ use crate::physics::{
     Dynamics, Excitation, GearParams, Loads, MainShaft, Polynomial, Region, Shaft, Sine, TorqueRamp,
 };
 use crate::rattle::torque::{self, TorqueRattle};
-use crate::rattle::window::{Metrics, Quadratures, Window};
+use crate::rattle::window::{self, Metrics, Quadratures, Window};
 use crate::rattle::{self, GearPair, Impacts, KinematicRattle, LeanRattle, Rattle};
 use fmi2_shell::values::Values;
 use journal::{Entry, Journal};
@@ -85,9 +85,10 @@ impl<S: Piecewise<N> + Jacobian<N> + Copy, const N: usize> Stepped<S, N> {
 
 impl<S: GearPair<N> + Jacobian<N> + Copy, const N: usize> Stepped<S, N> {
     /// Advances to t_end, through the opening of the statistics window on the way, where its
-    /// quadratures are kept. With `at_impact`, stops at the first impact (contact onset) on
-    /// the way, as located: true if it did. A failure leaves the pair where it failed (the
-    /// simulation's [`Journal`] puts it back).
+    /// quadratures are kept (on the call's start or end where it lies within the resolution
+    /// of time of them: [`window::opening`]). With `at_impact`, stops at the first impact
+    /// (contact onset) on the way, as located: true if it did. A failure leaves the pair
+    /// where it failed (the simulation's [`Journal`] puts it back).
     pub fn advance(
         &mut self,
         t: &mut f64,
@@ -98,9 +99,15 @@ impl<S: GearPair<N> + Jacobian<N> + Copy, const N: usize> Stepped<S, N> {
             let count = s.impacts().count;
             if at_impact { count[0] + count[1] } else { 0 }
         };
-        let window = self.system.window();
-        if !window.is_opened() && window.from <= t_end {
-            if self.step(t, window.from, impacts)? {
+        let w = self.system.window();
+        let opening = match w.is_opened() {
+            true => None,
+            false => window::opening(w.from, *t, t_end),
+        };
+        if let Some(from) = opening {
+            // It opens there: what happens from then on is counted.
+            self.system.window_mut().from = from;
+            if self.step(t, from, impacts)? {
                 return Ok(true);
             }
             self.open_window();
@@ -740,6 +747,75 @@ mod tests {
             assert!(lean && !all, "{case:?}");
             assert!(impacts[0] + impacts[1] > 0, "{case:?}: {impacts:?}");
             assert_eq!((outputs, impacts), (outputs_all, impacts_all), "{case:?}");
+        }
+    }
+
+    /// The window at 0.03 s and a master stepping 0.029 + 1e-3 (one ulp past it), or at two
+    /// ulps past that end: it opens within the resolution of time of the step's end, so it
+    /// opens there. In each mode the steps succeed, ended at each impact too (FMI 3.0's early
+    /// return), and every stat_* output equals that of the run whose window opens on the
+    /// communication point, to the last bit, with impacts counted in the window.
+    #[test]
+    fn a_window_within_rounding_of_a_step_end_opens_there() {
+        use fmi2_shell::contract::Kind;
+        let ulps = |x: f64, n: i64| f64::from_bits((x.to_bits() as i64 + n) as u64);
+        let t_end = 0.029 + 1e-3;
+        let run = |(excitation, solver): (i64, i64), stats_from: f64, at_impact: bool| {
+            let mut values = Values::start(crate::contract::VARIABLES);
+            // The bench's sine motion as inputs, or as the torque that gives it a shaft too
+            // heavy for the contact to move.
+            let sine = Sine::new(
+                values.real(vr::A_rms),
+                values.real(vr::f_exc),
+                values.real(vr::omega_mean),
+            );
+            let I_M = 10.0;
+            let start = sine.at(0.0);
+            values.set_integer(vr::excitation, excitation);
+            values.set_integer(vr::solver, solver);
+            values.set_real(vr::I_M, I_M);
+            values.set_real(vr::theta_M, start.theta);
+            values.set_real(vr::omega_M, start.omega);
+            values.set_real(vr::stats_from, stats_from);
+            let mut sim = Simulation::new(&values, 0.0, 0.0, 1e-6, Carry::Asked).unwrap();
+            let points = (0..20).map(|k| k as f64 * 1e-3);
+            for t in points.chain((0..40).map(|k| 0.02 + k as f64 * 1e-3)) {
+                let h = 1e-3;
+                // From the master's communication point, as the instance steps.
+                sim.t = t;
+                let (now, then) = (sine.at(t).alpha, sine.at(t + h).alpha);
+                sim.set_shaft(sine.at(t));
+                sim.set_torque(I_M * now, I_M * (then - now) / h);
+                while sim.step_until(t + h, at_impact).unwrap() < t + h {}
+            }
+            let now = sim.now();
+            let m = now.metrics(sim.t);
+            let stats = crate::contract::VARIABLES
+                .iter()
+                .filter(|v| v.name.starts_with("stat_"))
+                .map(|v| match v.kind {
+                    Kind::Real => stat_real(&m, v.vr).unwrap().to_bits(),
+                    _ => stat_integer(&m, v.vr).unwrap() as u64,
+                })
+                .collect::<Vec<_>>();
+            (stats, m.flanks[0].impacts + m.flanks[1].impacts, m.length)
+        };
+        for case in [
+            (EXCITATION_INPUTS, 0),
+            (EXCITATION_INPUTS, 2),
+            (EXCITATION_SINE, 0),
+            (EXCITATION_SINE, 2),
+            (EXCITATION_TORQUE, 0),
+        ] {
+            for at_impact in [false, true] {
+                let on_the_point = run(case, t_end, at_impact);
+                let (_, impacts, length) = on_the_point;
+                assert!(impacts > 0, "{case:?}: {impacts}");
+                assert_eq!(length, 0.06 - t_end, "{case:?}");
+                for from in [0.03, ulps(t_end, 2)] {
+                    assert_eq!(run(case, from, at_impact), on_the_point, "{case:?} {from}");
+                }
+            }
         }
     }
 

@@ -39,7 +39,7 @@ mod work;
 
 pub use control::Tolerance;
 pub use radau5::Jacobian;
-pub use solver::{Method, Solver, SolverError, Stats};
+pub use solver::{Method, Solver, SolverError, Stats, resolution};
 
 /// An ODE y' = f(t, y) with N components.
 pub trait System<const N: usize> {

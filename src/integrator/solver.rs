@@ -24,7 +24,7 @@ use super::{Crossing, Piecewise, taylor};
 use serde::{Deserialize, Serialize};
 
 pub use super::runge_kutta::Method;
-pub use super::work::{SolverError, Stats};
+pub use super::work::{SolverError, Stats, resolution};
 
 /// An accepted step, whichever stepper took it.
 enum Taken<'a, const N: usize> {

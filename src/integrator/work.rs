@@ -86,6 +86,14 @@ impl std::fmt::Display for SolverError {
     }
 }
 
+/// The resolution of time between t and t_end: the solver refuses a step there that is not
+/// longer ([`SolverError::StepTooSmall`]; `min_step_ulps` machine epsilons of the larger
+/// time).
+#[inline]
+pub fn resolution(t: f64, t_end: f64) -> f64 {
+    OPTIONS.min_step_ulps * f64::EPSILON * t.abs().max(t_end.abs())
+}
+
 /// The limits of one call of the solver's `advance`: steps taken, and edges crossed at the same
 /// instant.
 #[derive(Default)]
@@ -108,7 +116,7 @@ impl Budget {
     ) -> Result<(f64, bool), SolverError> {
         let last = !natural.is_finite() || (!past && t + OPTIONS.sliver * natural >= t_end);
         let h = if last { t_end - t } else { natural };
-        if h <= OPTIONS.min_step_ulps * f64::EPSILON * t.abs().max(t_end.abs()) {
+        if h <= resolution(t, t_end) {
             return Err(SolverError::StepTooSmall { t, h });
         }
         self.steps += 1;

@@ -7,6 +7,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::integrator::resolution;
 use crate::physics::Region;
 
 /// The quadratures of a gear pair's state, in this order from its `E_CONTACT` component on:
@@ -91,6 +92,24 @@ pub struct Slopes {
     pub F_std: Quadratures,
     pub P_contact: Quadratures,
     pub P_lubricant: Quadratures,
+}
+
+/// Where a statistics window that opens at `from` opens in a step from t to t_end, if it
+/// does: at `from`, or at the step's start or end where `from` lies within the resolution of
+/// time of it (the solver could not step the sliver between them: [`resolution`]); None if
+/// it opens later (or never: `from` infinite).
+pub fn opening(from: f64, t: f64, t_end: f64) -> Option<f64> {
+    // A step from a to b that the solver refuses (a backward one too).
+    let refused = |a: f64, b: f64| b - a <= resolution(a, b);
+    if !from.is_finite() {
+        None
+    } else if refused(t, from) {
+        Some(t)
+    } else if refused(from, t_end) && refused(t_end, from) {
+        Some(t_end)
+    } else {
+        (from <= t_end).then_some(from)
+    }
 }
 
 impl Window {
@@ -299,6 +318,32 @@ mod tests {
         assert_eq!(m.a_rms, 2.0);
         assert_eq!(m.F_std, 2.0);
         assert_eq!(m.regime(), (2, 0));
+    }
+
+    /// A window opens where it is asked to, unless that lies within the resolution of time of
+    /// the step's start or end: then there (the solver's resolution, 16 machine epsilons of
+    /// the time, is 1.07e-16 s about 0.03 s, 30.7 ulps of 3.5e-18 s).
+    #[test]
+    fn a_window_opens_on_a_step_end_within_the_resolution_of_time() {
+        let (t, t_end) = (0.029, 0.029 + 1e-3);
+        let ulps = |x: f64, n: i64| f64::from_bits((x.to_bits() as i64 + n) as u64);
+        assert_eq!(t_end, ulps(0.03, 1));
+        let cases = [
+            (0.03, Some(t_end)),
+            (ulps(t_end, -30), Some(t_end)),
+            (ulps(t_end, 30), Some(t_end)),
+            (ulps(t_end, -31), Some(ulps(t_end, -31))),
+            (ulps(t_end, 31), None),
+            (t_end, Some(t_end)),
+            (ulps(t, 29), Some(t)),
+            (ulps(t, 30), Some(ulps(t, 30))),
+            (t, Some(t)),
+            (0.0295, Some(0.0295)),
+            (f64::INFINITY, None),
+        ];
+        for (from, at) in cases {
+            assert_eq!(opening(from, t, t_end), at, "{from}");
+        }
     }
 
     /// Before the window opens, nothing is counted and every figure is zero.
