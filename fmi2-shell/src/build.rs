@@ -973,10 +973,12 @@ mod tests {
         assert!(xml.contains("<Unit name=\"degC\"><BaseUnit K=\"1\" offset=\"273.15\"/>"));
         let e = scalar(&xml, "n_gears");
         assert!(e.contains("min=\"1\" max=\"8\""), "{e}");
-        // The state vector: phi, x_omega_I, x_theta_F, x_omega_F, then each gear's xi and xi_dot.
+        // The state vector: phi, x_omega_I, x_theta_F, x_omega_F, E_damper, E_input_drag,
+        // W_flywheel, then each gear's xi, xi_dot, E_contact, E_lubricant, int_a2, int_F, int_F2.
         assert!(rust.contains(
-            "pub const STATES: &[u32] = &[45, 80, 81, 82, 1120, 1121, 1220, 1221, 1320, 1321, 1420, 1421, 1520, 1521, 1620, 1621, 1720, 1721, 1820, 1821];"
+            "pub const STATES: &[u32] = &[45, 80, 81, 82, 48, 83, 84, 1120, 1121, 1125, 1126, 1170, 1171, 1172, 1220,"
         ));
+        assert!(rust.contains("1820, 1821, 1825, 1826, 1870, 1871, 1872];"));
         assert!(rust.contains(
             "pub const I_L: [u32; 8] = [1101, 1201, 1301, 1401, 1501, 1601, 1701, 1801];"
         ));
@@ -1064,7 +1066,7 @@ mod tests {
         assert_eq!(vr::gear::locate(vr::n_gears), None);
         assert_eq!(contract::find(Kind::Real, vr::gear::G[0]).unwrap().name, "gear[1].G");
         assert_eq!(contract::find(Kind::Integer, vr::gear::contact[7]).unwrap().name, "gear[8].contact");
-        assert_eq!(contract::STATES.len(), 20);
+        assert_eq!(contract::STATES.len(), 7 + 7 * 8);
         assert_eq!(contract::EVENT_INDICATORS, 42);
         let mut values = Values::start(VARIABLES);
         assert!(contract::check_parameters(&values).is_ok());
