@@ -59,14 +59,15 @@ def alone(unzipdir, md, values, duration):
 def reads_alone(unzipdir, md, values, n):
     """CPU of the reads of n steps of meshes.record (the forces at every step, the counters at
     every WAV sample) without the steps: what calling the FMU's getters from Python costs."""
-    from gearrattle.sound.meshes import SUBSAMPLE, _raw_calls, meshes
+    from gearrattle.calls import raw_calls
+    from gearrattle.sound.meshes import SUBSAMPLE, meshes
 
     ms = meshes(md, values)
     inst = _initialised(unzipdir, md, values)
     vr_f = (ctypes.c_uint * len(ms))(*[m.force.valueReference for m in ms])
     vr_c = (ctypes.c_uint * (2 * len(ms)))(*[c.valueReference for m in ms for c in m.counters])
     F, C = np.zeros((n, len(ms))), np.zeros(len(vr_c), dtype=np.int32)
-    _, get_real, get_int = _raw_calls(inst)
+    _, get_real, get_int = raw_calls(inst)
     vf, vc, comp = ctypes.addressof(vr_f), ctypes.addressof(vr_c), inst.component
     f_at, c_at = F.ctypes.data, C.ctypes.data
     t0 = time.process_time()
@@ -83,11 +84,12 @@ def sampled_alone(unzipdir, md, values, duration, read):
     """CPU of meshes.record's calls of the FMU's sampling entry over duration (CHUNK each),
     reading the forces at every point if `read`, else none: the FMU's part of the stepping.
     None where the FMU does not export the entry."""
-    from gearrattle.sound.meshes import CHUNK, FS, SUBSAMPLE, _sampled_call, meshes
+    from gearrattle.calls import sampled_call
+    from gearrattle.sound.meshes import CHUNK, FS, SUBSAMPLE, meshes
 
     ms = meshes(md, values) if read else []
     inst = _initialised(unzipdir, md, values)
-    call = _sampled_call(inst)
+    call = sampled_call(inst)
     if call is None:
         _free(inst)
         return None
@@ -107,7 +109,8 @@ def sampled_alone(unzipdir, md, values, duration, read):
 def cost(fmu, unzip, md, values, duration):
     """Print the CPU of the simulation alone, of the WAV (the forces sampled, filtered, the mix
     and stems written) and of the metrics, best of 3 for the first two."""
-    from gearrattle.sound.meshes import CHUNK, SAMPLED, SUBSAMPLE, simulate
+    from gearrattle.calls import SAMPLED
+    from gearrattle.sound.meshes import CHUNK, SUBSAMPLE, simulate
     from gearrattle.sound.metrics import full_scale, metrics, write_wav
     from gearrattle.sound.modal import ModalTransfer
     from gearrattle.sound.render import render
@@ -145,7 +148,8 @@ def report(fmu, duration, sets, cost_only=False):
     from fmpy import extract, read_model_description
 
     from gearrattle.study.spec import parse_set
-    from gearrattle.sound.meshes import SAMPLED, SUBSAMPLE, simulate, start_values
+    from gearrattle.calls import SAMPLED
+    from gearrattle.sound.meshes import SUBSAMPLE, simulate, start_values
     from gearrattle.sound.metrics import full_scale, metrics, write_wav
     from gearrattle.sound.modal import ModalTransfer
     from gearrattle.sound.render import render

@@ -43,7 +43,7 @@ def outputs(md):
 
 def sampled(s, t, dt, n, vrs, values=None):
     """gearRattleDoStepSampled on the Slave's instance; values None passes NULL."""
-    call = M._sampled_call(s.fmu)
+    call = M.sampled_call(s.fmu)
     vr = (ctypes.c_uint * len(vrs))(*vrs)
     at = None if values is None else values.ctypes.data
     return call(s.fmu.component, t, dt, n, ctypes.addressof(vr), len(vrs), at)
@@ -105,7 +105,7 @@ def test_record_takes_the_same_forces_through_the_entry_as_through_the_plain_cal
     unzipdir, md = unzipped
     values = M.start_values(md, {})
     with_entry = M.simulate(unzipdir, md, values, 0.02)
-    monkeypatch.setattr(M, "_sampled_call", lambda inst: None)
+    monkeypatch.setattr(M, "sampled_call", lambda inst: None)
     plain = M.simulate(unzipdir, md, values, 0.02)
     for f, g in zip(with_entry.forces, plain.forces):
         # the two grids' points differ by rounding (t0 + k h against (t0 + k0 h) + j h)

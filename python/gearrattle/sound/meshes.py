@@ -16,12 +16,11 @@ import time
 
 import numpy as np
 
+from ..calls import SAMPLED, check, raw_calls, sampled_call
 from .metrics import FS
 
 SUBSAMPLE = 4  # force samples per WAV sample: h = 5.2 µs (docs/SOUND.md, "Error")
-# The FMU's export that takes a run of steps and reads the forces at each in one call
-# (fmi2-shell's, outside FMI), and the simulated time of one such call [s].
-SAMPLED = "gearRattleDoStepSampled"
+# The simulated time of one call of the sampling entry (gearrattle.calls.SAMPLED) [s].
 CHUNK = 0.01
 FORCE = "F_contact"
 COUNTERS = ("impacts_Fplus", "impacts_Fminus")
@@ -149,8 +148,8 @@ def record(inst, ms, t0, t_end, subsample=SUBSAMPLE):
     vr_c = (ctypes.c_uint * (2 * len(counted)))(
         *[c.valueReference for j in counted for c in ms[j].counters])
     F = np.zeros((m, n + 1))  # each mesh's force contiguous, for the filters
-    do_step, get_real, get_int = _raw_calls(inst)
-    sampled = _sampled_call(inst)
+    do_step, get_real, get_int = raw_calls(inst)
+    sampled = sampled_call(inst)
     every = max(1, int(round(CHUNK / h))) if sampled else subsample
     at = np.unique(np.r_[np.arange(0, n + 1, every), n])  # where the counters are read
     C = np.zeros((len(at), len(vr_c)), dtype=np.int32)  # fmi2Integer
@@ -165,10 +164,10 @@ def record(inst, ms, t0, t_end, subsample=SUBSAMPLE):
     for i in range(1, len(ends)):
         k0, k1 = ends[i - 1], ends[i]
         if sampled:
-            _ok(sampled(comp, t0 + k0 * h, h, k1 - k0, vf, m, r_at), SAMPLED, t0 + k0 * h)
+            check(sampled(comp, t0 + k0 * h, h, k1 - k0, vf, m, r_at), SAMPLED, t0 + k0 * h)
         else:
             for k in range(k0 + 1, k1 + 1):
-                _ok(do_step(comp, t0 + (k - 1) * h, h, 1), "fmi2DoStep", t0 + (k - 1) * h)
+                check(do_step(comp, t0 + (k - 1) * h, h, 1), "fmi2DoStep", t0 + (k - 1) * h)
                 get_real(comp, vf, m, r_at + row * (k - k0 - 1))
         F[:, k0 + 1:k1 + 1] = rows[:k1 - k0].T
         if counted:
@@ -178,42 +177,6 @@ def record(inst, ms, t0, t_end, subsample=SUBSAMPLE):
     for col, j in enumerate(counted):
         impacts[j] = _from_counters(at, C[:, 2 * col], C[:, 2 * col + 1], F[j], t0, h)
     return Run(h=h, t0=t0, forces=list(F), impacts=impacts, meshes=ms, values={}, steps=n)
-
-
-def _ok(status, name, t):
-    if status != 0:
-        raise RuntimeError(f"{name} at t = {t:.9g} s returned status {status}")
-
-
-def _raw_calls(inst):
-    """fmi2DoStep, fmi2GetReal and fmi2GetInteger of an fmpy instance as bare ctypes functions
-    that take the value arrays as addresses (ints): no fmpy wrapper, no pointer object a
-    call."""
-    import ctypes
-
-    P = ctypes.c_void_p
-    return (_bare(inst, "fmi2DoStep", P, ctypes.c_double, ctypes.c_double, ctypes.c_int),
-            _bare(inst, "fmi2GetReal", P, P, ctypes.c_size_t, P),
-            _bare(inst, "fmi2GetInteger", P, P, ctypes.c_size_t, P))
-
-
-def _sampled_call(inst):
-    """The FMU's SAMPLED (component, t, dt, nSamples, vr, nvr, values) as a bare ctypes
-    function, or None where its binary does not export it."""
-    import ctypes
-
-    P = ctypes.c_void_p
-    if not hasattr(inst.dll, SAMPLED):
-        return None
-    return _bare(inst, SAMPLED, P, ctypes.c_double, ctypes.c_double, ctypes.c_size_t, P,
-                 ctypes.c_size_t, P)
-
-
-def _bare(inst, name, *args):
-    import ctypes
-
-    return ctypes.CFUNCTYPE(ctypes.c_int, *args)(
-        ctypes.cast(getattr(inst.dll, name), ctypes.c_void_p).value)
 
 
 def _from_counters(at, n_plus, n_minus, F, t0, h):
