@@ -5,8 +5,10 @@ and measured on one output grid:
 * error: the largest |xi_i - xi_ref,i| / G_i over the five gears and the grid's points, the
   reference being DOP853 at rtol 1e-12 with every edge located (gearbox_reference); its own
   error is estimated by the same run at 1e-13;
-* the FMU: stepped by fmpy's FMU2Slave from one grid point to the next (the communication
-  points a user asks for), the five xi read at each, its tolerance set by fmi2SetupExperiment;
+* the FMU: stepped from one grid point to the next (the communication points a user asks
+  for), the five xi read at each, in one call of its sampling entry (gearrattle.calls.sample:
+  an fmi2DoStep and an fmi2GetReal a point inside the FMU, without Python's cost a call), its
+  tolerance set by fmi2SetupExperiment;
 * scipy: each of solve_ivp's methods driven by the reference's piecewise integration (edges
   located, a restart at each), the grid as its output times;
 * cost: CPU time (time.process_time) per simulated second, the FMU's from fmi2Instantiate to
@@ -28,6 +30,7 @@ import numpy as np
 
 from gearrattle import gearbox_fmu as GF
 from gearrattle import gearbox_reference as R
+from gearrattle.calls import sample
 from gearrattle.piecewise import output_grid
 
 from gearbox.runs import Stepper
@@ -98,7 +101,7 @@ def _fmu_xi(tol: float, n_gears: int):
     t0 = time.process_time()
     s.start({}, tol)
     s.fmu.exitInitializationMode()
-    rec = s.record(names, int(round(WINDOW / GRID)), GRID)
+    rec = sample(s.fmu, s.refs(names), 0.0, GRID, int(round(WINDOW / GRID)))
     s.fmu.terminate()
     cpu = time.process_time() - t0
     s.fmu.freeInstance()
@@ -192,7 +195,7 @@ def figure(path, curves, ref: Reference, rows):
         e = [p.err for p in c.points]
         k = [p.cost for p in c.points]
         ax.loglog(e, k, "o-" if c.name == FMU else ".--", lw=2 if c.name == FMU else 1,
-                  label="GearboxRattle FMU (fmpy)" if c.name == FMU else f"scipy {c.name}")
+                  label="GearboxRattle FMU" if c.name == FMU else f"scipy {c.name}")
     for lv, *_ in rows:
         ax.axvline(lv, color="grey", lw=0.5, ls=":")
     ax.axvspan(ref.floor, 10.0 * ref.floor, color="grey", alpha=0.15, label="below 10× the reference's error")
@@ -227,9 +230,10 @@ def summary(curves, ref: Reference, rows) -> list:
         "docs/gearbox_work_precision.png; the method: docs/DECISIONS.md D59). Error: the largest "
         f"|ξ_i − ξ_ref,i| / G_i of the {ref.G.size} gears on a {GRID * 1e3:g} ms grid ({n} points), against "
         f"DOP853 at rtol {REF_RTOL:g} with its edges located (at {CHECK_RTOL:g} it moves by {ref.floor:.1e} G, "
-        "so levels below ten times that are left out). Both sides output on that grid: the FMU stepped by "
-        "fmpy's FMU2Slave from one grid point to the next, its tolerance set by fmi2SetupExperiment, the "
-        "five ξ read at each; scipy's methods driven by the reference's piecewise integration (edges "
+        "so levels below ten times that are left out). Both sides output on that grid: the FMU stepped "
+        "from one grid point to the next, its tolerance set by fmi2SetupExperiment, the five ξ read at "
+        "each, in one call of its sampling entry (an fmi2DoStep and an fmi2GetReal a point inside the "
+        "FMU; docs/SOUND.md); scipy's methods driven by the reference's piecewise integration (edges "
         "located, a restart at each) with the grid as output times. Cost: CPU time per simulated second "
         "(the FMU from fmi2Instantiate to its last output, scipy the whole call; the median of 3 runs "
         "under 2 s), interpolated on each log-log curve between the tolerances that bracket the level.",
