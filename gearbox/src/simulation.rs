@@ -11,6 +11,7 @@ use crate::windowed::{self, Windowed};
 use fmi2_shell::values::Values;
 use fmi2_shell::{FmiError, FmiResult};
 use gear_rattle::gearbox::{self, Drive, Gearbox, GearboxParams, LooseGear, PHI, State, xi};
+use gear_rattle::instance::simulation::journal::Journal;
 use gear_rattle::instance::simulation::{Stepped, method};
 use gear_rattle::integrator::{Method, Solver, SolverError, Stats};
 use gear_rattle::physics::{
@@ -49,6 +50,25 @@ pub struct Simulation {
     /// Model Exchange: the importer integrates, the outputs take the pieces the states are
     /// in.
     pub model_exchange: bool,
+    /// What puts a failed step back: a copy of the run and the time, and the changes since.
+    #[serde(skip)]
+    journal: Journal<(Run, f64), Entry, ENTRIES>,
+}
+
+/// How many changes the journal records before it takes a new copy of the run.
+const ENTRIES: usize = 64;
+
+/// A change of the simulation in co-simulation, as the journal records it.
+#[derive(Clone, Copy, Debug)]
+enum Entry {
+    /// A step from `from` to `to` ([`Simulation::step_until`]).
+    Step { from: f64, to: f64, at_impact: bool },
+    /// New flywheel inputs (excitation 0).
+    Flywheel(Shaft),
+    /// New input-side inputs (excitation 2).
+    InputSide(Shaft),
+    /// The output shaft's speed.
+    OutputSpeed(f64),
 }
 
 /// The gearbox's parameters as set: gears 1..n_gears from the per-gear arrays (C and c_I at
@@ -192,6 +212,7 @@ impl Simulation {
                 method,
                 interpolate_ends: false,
                 model_exchange,
+                journal: Journal::default(),
             });
         }
         let interpolate_ends = matches!(drive, Drive::Engine(_));
@@ -205,6 +226,7 @@ impl Simulation {
             method,
             interpolate_ends,
             model_exchange,
+            journal: Journal::default(),
         };
         if sim.window_from <= t0 {
             sim.open_window();
@@ -228,20 +250,84 @@ impl Simulation {
     /// Advances to t_end, through the window's opening on the way, with `at_impact` stopping
     /// at the first impact (contact onset) of any gear on the way, where the integrator
     /// locates it ([`Solver::advance_until`]); returns the time reached. On failure the
-    /// simulation is left as it was.
+    /// simulation is left as it was (replayed by its [`Journal`]).
     pub fn step_until(&mut self, t_end: f64, at_impact: bool) -> Result<f64, SolverError> {
+        let from = self.t;
+        self.journaled(Entry::Step {
+            from,
+            to: t_end,
+            at_impact,
+        })
+    }
+
+    /// Makes the change `entry` and records it in the journal; if it fails (a step), puts
+    /// the simulation back as it was before. Returns the time reached.
+    fn journaled(&mut self, entry: Entry) -> Result<f64, SolverError> {
+        self.journal.before(|| (self.run.clone(), self.t));
+        match self.apply(entry) {
+            Ok(reached) => {
+                self.journal.record(entry);
+                Ok(reached)
+            }
+            Err(e) => {
+                self.replay();
+                Err(e)
+            }
+        }
+    }
+
+    /// Back to the state before the step that failed: the journal's copy, then the changes
+    /// made since.
+    #[cold]
+    fn replay(&mut self) {
+        let journal = std::mem::take(&mut self.journal);
+        let ((run, t), entries) = journal.replay();
+        (self.run, self.t) = (run.clone(), *t);
+        for entry in entries {
+            self.apply(entry)
+                .expect("a change that succeeded succeeds again from the same state");
+        }
+        self.journal = journal;
+    }
+
+    /// The change `entry` without the journal: a failed step leaves the simulation where it
+    /// failed. Returns the time reached.
+    fn apply(&mut self, entry: Entry) -> Result<f64, SolverError> {
+        match entry {
+            Entry::Step {
+                from,
+                to,
+                at_impact,
+            } => {
+                self.t = from;
+                return self.advance(to, at_impact);
+            }
+            Entry::Flywheel(shaft) => self.change_state(|g, t, y| {
+                g.set_flywheel(t, y, shaft);
+            }),
+            Entry::InputSide(shaft) => match &mut self.run {
+                Run::Independent(p) => p.set_input_side(self.t, shaft),
+                _ => self.change_state(|g, t, y| {
+                    g.set_input_side(t, y, shaft);
+                }),
+            },
+            Entry::OutputSpeed(omega_out) => match &mut self.run {
+                Run::Independent(p) => p.set_output_speed(omega_out),
+                _ => self.change_state(|g, _, _| g.set_output_speed(omega_out)),
+            },
+        }
+        Ok(self.t)
+    }
+
+    /// [`step_until`](Self::step_until) without the journal.
+    fn advance(&mut self, t_end: f64, at_impact: bool) -> Result<f64, SolverError> {
         let stopped = if matches!(self.run, Run::Lean(_)) && self.window_from <= t_end {
-            let before = self.clone();
-            let advanced = self
-                .advance_until(self.window_from, at_impact)
-                .and_then(|stopped| {
-                    if stopped {
-                        return Ok(true);
-                    }
-                    self.open_window();
-                    self.advance_until(t_end, at_impact)
-                });
-            advanced.inspect_err(|_| *self = before)?
+            if self.advance_until(self.window_from, at_impact)? {
+                true
+            } else {
+                self.open_window();
+                self.advance_until(t_end, at_impact)?
+            }
         } else {
             self.advance_until(t_end, at_impact)?
         };
@@ -313,30 +399,26 @@ impl Simulation {
     /// New flywheel inputs (excitation 0; ignored otherwise): φ and φ' follow at once.
     pub fn set_flywheel(&mut self, shaft: Shaft) {
         if matches!(self.gearbox().0.drive, Drive::Flywheel(_)) {
-            self.change_state(|g, t, y| {
-                g.set_flywheel(t, y, shaft);
-            });
+            self.change(Entry::Flywheel(shaft));
         }
     }
 
     /// New input-side inputs (excitation 2; ignored otherwise): the ξ_i follow at once.
     pub fn set_input_side(&mut self, shaft: Shaft) {
-        if let Run::Independent(p) = &mut self.run {
-            p.set_input_side(self.t, shaft);
-        } else if matches!(self.gearbox().0.drive, Drive::InputSide(_)) {
-            self.change_state(|g, t, y| {
-                g.set_input_side(t, y, shaft);
-            });
+        if matches!(self.gearbox().0.drive, Drive::InputSide(_)) {
+            self.change(Entry::InputSide(shaft));
         }
     }
 
     /// The output shaft's speed.
     pub fn set_output_speed(&mut self, omega_out: f64) {
-        if let Run::Independent(p) = &mut self.run {
-            p.set_output_speed(omega_out);
-        } else {
-            self.change_state(|g, _, _| g.set_output_speed(omega_out));
-        }
+        self.change(Entry::OutputSpeed(omega_out));
+    }
+
+    /// A change of inputs, journaled (it cannot fail).
+    fn change(&mut self, entry: Entry) {
+        self.journaled(entry)
+            .expect("a change of inputs does not step");
     }
 
     /// The imposed motion's extrapolation now (excitation 0: the flywheel's, 2: the input
@@ -359,5 +441,83 @@ impl Simulation {
 
     pub fn proposed_step(&self) -> f64 {
         on_run!(&self.run, k => k.solver.proposed_step(), p => p.proposed_step())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A step that fails leaves the simulation as it was, run and solver compared whole, in
+    /// every kind of run: the coupled box (inputs, excitation 0) before its window opens, with
+    /// the window opening among the journaled steps and open from the start, and the gears
+    /// stepped apart (the input side, excitation 2);
+    /// after more steps than a journal records, with new inputs among them: its journal
+    /// replays them. The step fails on its first attempt, below the resolution of time, after
+    /// new inputs have made the solver evaluate the derivative there. It then goes on as if the
+    /// failed step had not been asked for.
+    #[test]
+    fn a_failed_step_leaves_the_simulation_as_it_was() {
+        // The excitation, where the window opens and the kind of run it ends in.
+        let cases = [
+            (EXCITATION_FLYWHEEL, 10.0, "Lean"),
+            (EXCITATION_FLYWHEEL, 5e-3, "Windowed"),
+            (EXCITATION_FLYWHEEL, 0.0, "Windowed"),
+            (EXCITATION_INPUT_SIDE, 2e-3, "Independent"),
+        ];
+        std::thread::Builder::new()
+            .stack_size(8 << 20)
+            .spawn(move || {
+                for (excitation, stats_from, kind) in cases {
+                    let case = format!("excitation {excitation}, window from {stats_from}");
+                    let mut values = Values::start(contract::VARIABLES);
+                    values.set_integer(vr::excitation, excitation);
+                    values.set_integer(vr::n_gears, 3);
+                    values.set_real(vr::omega_F, 84.0);
+                    values.set_real(vr::omega_I, 84.0);
+                    values.set_real(vr::stats_from, stats_from);
+                    let mut sim = Simulation::new(&values, 0.0, 1e-6, false).unwrap();
+                    let steps = ENTRIES + ENTRIES / 2;
+                    let inputs = |k: usize| Shaft {
+                        theta: 84.0 * k as f64 * 1e-4,
+                        omega: 84.0 + (k as f64 * 0.7).sin(),
+                        alpha: 0.0,
+                    };
+                    for k in 1..=steps {
+                        sim.step_until(k as f64 * 1e-4, false).unwrap();
+                        if k % 7 == 0 {
+                            sim.set_flywheel(inputs(k));
+                            sim.set_input_side(inputs(k));
+                            sim.set_output_speed(20.0 + k as f64 * 1e-2);
+                        }
+                    }
+                    let ran = match &sim.run {
+                        Run::Lean(_) => "Lean",
+                        Run::Windowed(_) => "Windowed",
+                        Run::Independent(_) => "Independent",
+                    };
+                    assert_eq!(ran, kind, "{case}");
+                    sim.set_output_speed(21.0);
+                    // More changes than the journal records: it holds those since its last copy.
+                    assert!(!sim.journal.is_empty() && sim.journal.len() < steps);
+                    let before = sim.clone();
+                    let t = sim.t;
+                    assert!(
+                        sim.step_until(t + 4.0 * f64::EPSILON * t, false).is_err(),
+                        "{case}"
+                    );
+                    assert!(sim == before, "{case}");
+                    assert_eq!(sim.stats(), before.stats(), "{case}");
+                    let mut unfailed = before;
+                    for k in steps + 1..=steps + 20 {
+                        sim.step_until(k as f64 * 1e-4, false).unwrap();
+                        unfailed.step_until(k as f64 * 1e-4, false).unwrap();
+                    }
+                    assert!(sim == unfailed, "{case}");
+                }
+            })
+            .unwrap()
+            .join()
+            .unwrap();
     }
 }

@@ -19,9 +19,9 @@ use crate::rattle::torque::{self, TorqueRattle};
 use crate::rattle::window::{Metrics, Quadratures, Window, quadrature};
 use crate::rattle::{self, GearPair, Impacts, KinematicRattle, LeanRattle, Rattle};
 use fmi2_shell::values::Values;
-use journal::{Entry, Journal};
+use journal::{ENTRIES, Entry, Journal};
 
-mod journal;
+pub mod journal;
 
 /// Values of the `excitation` parameter.
 pub const EXCITATION_INPUTS: i64 = 0;
@@ -51,32 +51,17 @@ pub struct Stepped<S, const N: usize> {
 }
 
 impl<S: Piecewise<N> + Jacobian<N> + Copy, const N: usize> Stepped<S, N> {
-    /// Advances to t_end; on failure the system, its solver and t are left as they were. A
-    /// call served from the solver's kept step cannot fail and needs no copy to roll back to
-    /// (at 10 µs communication steps most are).
-    pub fn advance_to(&mut self, t: &mut f64, t_end: f64) -> Result<(), SolverError> {
-        self.advance_until(t, t_end, |_| 0).map(|_| ())
-    }
-
-    /// [`advance_to`](Self::advance_to), stopping on the first edge crossed that raises the
-    /// system's count of `events` ([`Solver::advance_until`]): true if it stopped there.
+    /// Advances to t_end, stopping on the first edge crossed that raises the system's count
+    /// of `events` ([`Solver::advance_until`]): true if it stopped there. A failure leaves
+    /// the system where it failed (its simulation's [`Journal`] puts it back).
     pub fn advance_until(
         &mut self,
         t: &mut f64,
         t_end: f64,
         events: impl Fn(&S) -> u64,
     ) -> Result<bool, SolverError> {
-        if self.solver.serve(&mut self.system, t, &mut self.y, t_end) {
-            return Ok(false);
-        }
-        let (before, t_before) = (*self, *t);
-        let advanced = self
-            .solver
-            .advance_until(&mut self.system, t, &mut self.y, t_end, events);
-        if advanced.is_err() {
-            (*self, *t) = (before, t_before);
-        }
-        advanced
+        self.solver
+            .advance_until(&mut self.system, t, &mut self.y, t_end, events)
     }
 }
 
@@ -97,23 +82,12 @@ impl<S: GearPair<N> + Jacobian<N> + Copy, const N: usize> Stepped<S, N> {
         };
         let window = self.system.window();
         if !window.is_opened() && window.from <= t_end {
-            if self.step(t, window.from, impacts)? {
+            if self.advance_until(t, window.from, impacts)? {
                 return Ok(true);
             }
             self.open_window();
         }
-        self.step(t, t_end, impacts)
-    }
-
-    /// The solver's call towards t_end, stopping at the first edge that raises `events`.
-    fn step(
-        &mut self,
-        t: &mut f64,
-        t_end: f64,
-        events: impl Fn(&S) -> u64,
-    ) -> Result<bool, SolverError> {
-        self.solver
-            .advance_until(&mut self.system, t, &mut self.y, t_end, events)
+        self.advance_until(t, t_end, impacts)
     }
 
     /// The pair at t0 with the state's first components `head` (the quadratures from 0) and
@@ -248,7 +222,7 @@ pub struct Simulation {
     pub drive: Drive,
     /// What puts a failed step back (see `journal`).
     #[serde(skip)]
-    journal: Journal,
+    journal: Journal<(Gear, f64, Drive), Entry, ENTRIES>,
 }
 
 /// What every output is computed from at the current time, whichever the coupling (the
@@ -444,7 +418,7 @@ impl Simulation {
     /// the new inputs (direct feedthrough). In the other modes the inputs are not used.
     pub fn set_shaft(&mut self, shaft: Shaft) {
         if let Drive::Inputs(_) = self.drive {
-            self.journal.before(&self.gear, self.t, &self.drive);
+            self.journal.before(|| (self.gear, self.t, self.drive));
             self.apply_shaft(shaft);
             self.journal.record(Entry::Shaft(shaft));
         }
@@ -464,7 +438,7 @@ impl Simulation {
     /// does not jump: only the shaft's acceleration, read at once as alpha_M_out, changes.
     pub fn set_torque(&mut self, tau: f64, rate: f64) {
         if let Drive::Torque { .. } = self.drive {
-            self.journal.before(&self.gear, self.t, &self.drive);
+            self.journal.before(|| (self.gear, self.t, self.drive));
             self.apply_torque(tau, rate);
             self.journal.record(Entry::Torque { tau, rate });
         }
@@ -492,7 +466,7 @@ impl Simulation {
     /// the integrator locates it); returns the time reached. On failure the simulation is
     /// left as it was (replayed by its [`Journal`]).
     pub fn step_until(&mut self, t_end: f64, at_impact: bool) -> Result<f64, SolverError> {
-        self.journal.before(&self.gear, self.t, &self.drive);
+        self.journal.before(|| (self.gear, self.t, self.drive));
         let from = self.t;
         match self.advance(t_end, at_impact) {
             Ok(reached) => {
@@ -515,10 +489,10 @@ impl Simulation {
     #[cold]
     fn replay(&mut self) {
         let journal = self.journal;
-        let ((gear, t, drive), entries) = journal.replay();
+        let (&(gear, t, drive), entries) = journal.replay();
         (self.gear, self.t, self.drive) = (gear, t, drive);
         for entry in entries {
-            match *entry {
+            match entry {
                 Entry::Step {
                     from,
                     to,
@@ -800,7 +774,7 @@ mod tests {
             values.set_real(vr::tau_in, 0.5);
             values.set_real(vr::stats_from, 2e-3);
             let mut sim = Simulation::new(&values, 0.0, 0.0, 1e-6, Carry::Asked).unwrap();
-            let steps = journal::ENTRIES + journal::ENTRIES / 2;
+            let steps = ENTRIES + ENTRIES / 2;
             for k in 1..=steps {
                 sim.step_to(k as f64 * 1e-4).unwrap();
                 // New inputs now and then (each mode takes its own).
@@ -813,7 +787,7 @@ mod tests {
                     sim.set_torque(0.5 + k as f64 * 1e-3, 2.0);
                 }
             }
-            assert!(sim.journal.len() > 0 && sim.journal.len() < steps / 2);
+            assert!(!sim.journal.is_empty() && sim.journal.len() < steps / 2);
             let before = sim;
             let t = sim.t;
             assert!(sim.step_to(t + 4.0 * f64::EPSILON * t).is_err());
