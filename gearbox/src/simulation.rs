@@ -55,8 +55,10 @@ pub struct Simulation {
     journal: Journal<(Run, f64), Entry, ENTRIES>,
 }
 
-/// How many changes the journal records before it takes a new copy of the run.
-const ENTRIES: usize = 64;
+/// How many changes the journal records before it takes a new copy of the run (145 KB with
+/// the window open): a communication point served from the kept step is a change too, and
+/// the sound's grid has some 13 of them per integrator step (docs/DECISIONS.md D60).
+const ENTRIES: usize = 1024;
 
 /// A change of the simulation in co-simulation, as the journal records it.
 #[derive(Clone, Copy, Debug)]
