@@ -11,7 +11,7 @@ use crate::windowed::{self, Windowed};
 use fmi2_shell::values::Values;
 use fmi2_shell::{FmiError, FmiResult};
 use gear_rattle::gearbox::{self, Drive, Gearbox, GearboxParams, LooseGear, PHI, State, xi};
-use gear_rattle::instance::simulation::journal::Journal;
+use gear_rattle::instance::simulation::journal::{Journal, Journaled};
 use gear_rattle::instance::simulation::{Stepped, method};
 use gear_rattle::integrator::{Method, Solver, SolverError, Stats};
 use gear_rattle::physics::{
@@ -62,7 +62,7 @@ const ENTRIES: usize = 1024;
 
 /// A change of the simulation in co-simulation, as the journal records it.
 #[derive(Clone, Copy, Debug)]
-enum Entry {
+pub enum Entry {
     /// A step from `from` to `to` ([`Simulation::step_until`]).
     Step { from: f64, to: f64, at_impact: bool },
     /// New flywheel inputs (excitation 0).
@@ -254,71 +254,11 @@ impl Simulation {
     /// locates it ([`Solver::advance_until`]); returns the time reached. On failure the
     /// simulation is left as it was (replayed by its [`Journal`]).
     pub fn step_until(&mut self, t_end: f64, at_impact: bool) -> Result<f64, SolverError> {
-        let from = self.t;
         self.journaled(Entry::Step {
-            from,
+            from: self.t,
             to: t_end,
             at_impact,
         })
-    }
-
-    /// Makes the change `entry` and records it in the journal; if it fails (a step), puts
-    /// the simulation back as it was before. Returns the time reached.
-    fn journaled(&mut self, entry: Entry) -> Result<f64, SolverError> {
-        self.journal.before(|| (self.run.clone(), self.t));
-        match self.apply(entry) {
-            Ok(reached) => {
-                self.journal.record(entry);
-                Ok(reached)
-            }
-            Err(e) => {
-                self.replay();
-                Err(e)
-            }
-        }
-    }
-
-    /// Back to the state before the step that failed: the journal's copy, then the changes
-    /// made since.
-    #[cold]
-    fn replay(&mut self) {
-        let journal = std::mem::take(&mut self.journal);
-        let ((run, t), entries) = journal.replay();
-        (self.run, self.t) = (run.clone(), *t);
-        for entry in entries {
-            self.apply(entry)
-                .expect("a change that succeeded succeeds again from the same state");
-        }
-        self.journal = journal;
-    }
-
-    /// The change `entry` without the journal: a failed step leaves the simulation where it
-    /// failed. Returns the time reached.
-    fn apply(&mut self, entry: Entry) -> Result<f64, SolverError> {
-        match entry {
-            Entry::Step {
-                from,
-                to,
-                at_impact,
-            } => {
-                self.t = from;
-                return self.advance(to, at_impact);
-            }
-            Entry::Flywheel(shaft) => self.change_state(|g, t, y| {
-                g.set_flywheel(t, y, shaft);
-            }),
-            Entry::InputSide(shaft) => match &mut self.run {
-                Run::Independent(p) => p.set_input_side(self.t, shaft),
-                _ => self.change_state(|g, t, y| {
-                    g.set_input_side(t, y, shaft);
-                }),
-            },
-            Entry::OutputSpeed(omega_out) => match &mut self.run {
-                Run::Independent(p) => p.set_output_speed(omega_out),
-                _ => self.change_state(|g, _, _| g.set_output_speed(omega_out)),
-            },
-        }
-        Ok(self.t)
     }
 
     /// [`step_until`](Self::step_until) without the journal.
@@ -417,12 +357,6 @@ impl Simulation {
         self.change(Entry::OutputSpeed(omega_out));
     }
 
-    /// A change of inputs, journaled (it cannot fail).
-    fn change(&mut self, entry: Entry) {
-        self.journaled(entry)
-            .expect("a change of inputs does not step");
-    }
-
     /// The imposed motion's extrapolation now (excitation 0: the flywheel's, 2: the input
     /// side's), which the inputs follow until the master sets them again.
     pub fn extrapolated_inputs(&self) -> Option<(bool, Shaft)> {
@@ -443,6 +377,51 @@ impl Simulation {
 
     pub fn proposed_step(&self) -> f64 {
         on_run!(&self.run, k => k.solver.proposed_step(), p => p.proposed_step())
+    }
+}
+
+/// The gearbox's changes in co-simulation: steps and new inputs.
+impl Journaled<ENTRIES> for Simulation {
+    type Copy = (Run, f64);
+    type Entry = Entry;
+
+    fn journal(&mut self) -> &mut Journal<Self::Copy, Entry, ENTRIES> {
+        &mut self.journal
+    }
+
+    fn copy(&self) -> Self::Copy {
+        (self.run.clone(), self.t)
+    }
+
+    fn restore(&mut self, (run, t): &Self::Copy) {
+        (self.run, self.t) = (run.clone(), *t);
+    }
+
+    fn apply(&mut self, entry: Entry) -> Result<f64, SolverError> {
+        match entry {
+            Entry::Step {
+                from,
+                to,
+                at_impact,
+            } => {
+                self.t = from;
+                return self.advance(to, at_impact);
+            }
+            Entry::Flywheel(shaft) => self.change_state(|g, t, y| {
+                g.set_flywheel(t, y, shaft);
+            }),
+            Entry::InputSide(shaft) => match &mut self.run {
+                Run::Independent(p) => p.set_input_side(self.t, shaft),
+                _ => self.change_state(|g, t, y| {
+                    g.set_input_side(t, y, shaft);
+                }),
+            },
+            Entry::OutputSpeed(omega_out) => match &mut self.run {
+                Run::Independent(p) => p.set_output_speed(omega_out),
+                _ => self.change_state(|g, _, _| g.set_output_speed(omega_out)),
+            },
+        }
+        Ok(self.t)
     }
 }
 

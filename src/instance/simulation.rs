@@ -19,7 +19,7 @@ use crate::rattle::torque::{self, TorqueRattle};
 use crate::rattle::window::{Metrics, Quadratures, Window, quadrature};
 use crate::rattle::{self, GearPair, Impacts, KinematicRattle, LeanRattle, Rattle};
 use fmi2_shell::values::Values;
-use journal::{ENTRIES, Entry, Journal};
+use journal::{ENTRIES, Entry, Journal, Journaled};
 
 pub mod journal;
 
@@ -418,9 +418,7 @@ impl Simulation {
     /// the new inputs (direct feedthrough). In the other modes the inputs are not used.
     pub fn set_shaft(&mut self, shaft: Shaft) {
         if let Drive::Inputs(_) = self.drive {
-            self.journal.before(|| (self.gear, self.t, self.drive));
-            self.apply_shaft(shaft);
-            self.journal.record(Entry::Shaft(shaft));
+            self.change(Entry::Shaft(shaft));
         }
     }
 
@@ -438,9 +436,7 @@ impl Simulation {
     /// does not jump: only the shaft's acceleration, read at once as alpha_M_out, changes.
     pub fn set_torque(&mut self, tau: f64, rate: f64) {
         if let Drive::Torque { .. } = self.drive {
-            self.journal.before(|| (self.gear, self.t, self.drive));
-            self.apply_torque(tau, rate);
-            self.journal.record(Entry::Torque { tau, rate });
+            self.change(Entry::Torque { tau, rate });
         }
     }
 
@@ -466,46 +462,11 @@ impl Simulation {
     /// the integrator locates it); returns the time reached. On failure the simulation is
     /// left as it was (replayed by its [`Journal`]).
     pub fn step_until(&mut self, t_end: f64, at_impact: bool) -> Result<f64, SolverError> {
-        self.journal.before(|| (self.gear, self.t, self.drive));
-        let from = self.t;
-        match self.advance(t_end, at_impact) {
-            Ok(reached) => {
-                self.journal.record(Entry::Step {
-                    from,
-                    to: t_end,
-                    at_impact,
-                });
-                Ok(reached)
-            }
-            Err(e) => {
-                self.replay();
-                Err(e)
-            }
-        }
-    }
-
-    /// Back to the state before the step that failed: the journal's copy, then the changes
-    /// made since.
-    #[cold]
-    fn replay(&mut self) {
-        let journal = self.journal;
-        let (&(gear, t, drive), entries) = journal.replay();
-        (self.gear, self.t, self.drive) = (gear, t, drive);
-        for entry in entries {
-            match entry {
-                Entry::Step {
-                    from,
-                    to,
-                    at_impact,
-                } => {
-                    self.t = from;
-                    self.advance(to, at_impact)
-                        .expect("a step that succeeded succeeds again from the same state");
-                }
-                Entry::Shaft(shaft) => self.apply_shaft(shaft),
-                Entry::Torque { tau, rate } => self.apply_torque(tau, rate),
-            }
-        }
+        self.journaled(Entry::Step {
+            from: self.t,
+            to: t_end,
+            at_impact,
+        })
     }
 
     /// [`step_until`](Self::step_until) without the journal: a failure leaves the simulation
@@ -661,6 +622,40 @@ impl Simulation {
             }
             _ => return stat_integer(&now.metrics(self.t), vr),
         })
+    }
+}
+
+/// GearRattle's changes in co-simulation: steps and new inputs.
+impl Journaled<ENTRIES> for Simulation {
+    type Copy = (Gear, f64, Drive);
+    type Entry = Entry;
+
+    fn journal(&mut self) -> &mut Journal<Self::Copy, Entry, ENTRIES> {
+        &mut self.journal
+    }
+
+    fn copy(&self) -> Self::Copy {
+        (self.gear, self.t, self.drive)
+    }
+
+    fn restore(&mut self, copy: &Self::Copy) {
+        (self.gear, self.t, self.drive) = *copy;
+    }
+
+    fn apply(&mut self, entry: Entry) -> Result<f64, SolverError> {
+        match entry {
+            Entry::Step {
+                from,
+                to,
+                at_impact,
+            } => {
+                self.t = from;
+                return self.advance(to, at_impact);
+            }
+            Entry::Shaft(shaft) => self.apply_shaft(shaft),
+            Entry::Torque { tau, rate } => self.apply_torque(tau, rate),
+        }
+        Ok(self.t)
     }
 }
 

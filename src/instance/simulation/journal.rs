@@ -3,17 +3,18 @@
 //! changes made since (each step's start, end time and `at_impact`, each new input).
 //! Replayed from the copy, they give the state before the failed step to the bit: a step
 //! depends on nothing else. Model Exchange, which moves the state from outside, never steps.
-//! GearRattle's [`Simulation`](super::Simulation) keeps one of [`Entry`]s, GearboxRattle's
-//! one of its own.
+//! A simulation makes its changes through [`Journaled`]: GearRattle's
+//! [`Simulation`](super::Simulation) with [`Entry`]s, GearboxRattle's with its own.
 
+use crate::integrator::SolverError;
 use crate::physics::Shaft;
 
 /// How many changes GearRattle's journal records before it takes a new copy.
-pub(super) const ENTRIES: usize = 64;
+pub const ENTRIES: usize = 64;
 
 /// A change of GearRattle's simulation since the journal's copy, in the order made.
 #[derive(Clone, Copy, Debug)]
-pub(super) enum Entry {
+pub enum Entry {
     /// A step from `from` to `to` that succeeded (`Simulation::step_until`).
     Step { from: f64, to: f64, at_impact: bool },
     /// New inputs of the main shaft (`Simulation::set_shaft`).
@@ -49,25 +50,27 @@ impl<C, E, const ENTRIES: usize> PartialEq for Journal<C, E, ENTRIES> {
 }
 
 impl<C, E: Copy, const ENTRIES: usize> Journal<C, E, ENTRIES> {
-    /// Before a change of the simulation: a new copy of it (`copy`) if the journal has none
-    /// or is full.
+    /// Whether the next change needs a new copy first: the journal has none or is full.
     #[inline]
-    pub fn before(&mut self, copy: impl FnOnce() -> C) {
-        if self.copy.is_none() || self.len == ENTRIES {
-            self.copy = Some(copy());
-            self.len = 0;
-        }
+    fn is_due(&self) -> bool {
+        self.copy.is_none() || self.len == ENTRIES
     }
 
-    /// After the change `entry`, made since [`before`](Self::before).
+    /// A new copy, taken before the next change, and no changes since.
+    fn start(&mut self, copy: C) {
+        self.copy = Some(copy);
+        self.len = 0;
+    }
+
+    /// After the change `entry`, made since the copy.
     #[inline]
-    pub fn record(&mut self, entry: E) {
+    fn record(&mut self, entry: E) {
         self.entries[self.len] = Some(entry);
         self.len += 1;
     }
 
     /// The copy and the changes since it, in the order made.
-    pub fn replay(&self) -> (&C, impl Iterator<Item = E> + '_) {
+    fn replay(&self) -> (&C, impl Iterator<Item = E> + '_) {
         let copy = self.copy.as_ref().expect("taken before the first change");
         (copy, self.entries[..self.len].iter().flatten().copied())
     }
@@ -79,5 +82,76 @@ impl<C, E: Copy, const ENTRIES: usize> Journal<C, E, ENTRIES> {
 
     pub fn is_empty(&self) -> bool {
         self.len == 0
+    }
+}
+
+/// A simulation whose changes a journal of `ENTRIES` records: each change made through
+/// [`journaled`](Self::journaled), a failed one put back by [`replay`](Self::replay).
+pub trait Journaled<const ENTRIES: usize> {
+    /// What the journal copies: what the changes move.
+    type Copy;
+    /// A change.
+    type Entry: Copy;
+
+    fn journal(&mut self) -> &mut Journal<Self::Copy, Self::Entry, ENTRIES>;
+
+    /// A copy of what the changes move.
+    fn copy(&self) -> Self::Copy;
+
+    /// Back to `copy`.
+    fn restore(&mut self, copy: &Self::Copy);
+
+    /// Makes the change `entry` without the journal: a failed step leaves the simulation
+    /// where it failed. Returns the time reached.
+    fn apply(&mut self, entry: Self::Entry) -> Result<f64, SolverError>;
+
+    /// Makes the change `entry` and records it; if it fails (a step), puts the simulation
+    /// back as it was before. Returns the time reached.
+    #[inline]
+    fn journaled(&mut self, entry: Self::Entry) -> Result<f64, SolverError>
+    where
+        Self: Sized,
+    {
+        if self.journal().is_due() {
+            let copy = self.copy();
+            self.journal().start(copy);
+        }
+        match self.apply(entry) {
+            Ok(reached) => {
+                self.journal().record(entry);
+                Ok(reached)
+            }
+            Err(e) => {
+                self.replay();
+                Err(e)
+            }
+        }
+    }
+
+    /// Makes a change that cannot fail (new inputs) and records it.
+    fn change(&mut self, entry: Self::Entry)
+    where
+        Self: Sized,
+    {
+        self.journaled(entry)
+            .expect("a change of inputs does not step");
+    }
+
+    /// Back to the state before the change that failed: the journal's copy, then the
+    /// changes made since.
+    #[cold]
+    fn replay(&mut self)
+    where
+        Self: Sized,
+    {
+        let mut journal = Journal::default();
+        std::mem::swap(self.journal(), &mut journal);
+        let (copy, entries) = journal.replay();
+        self.restore(copy);
+        for entry in entries {
+            self.apply(entry)
+                .expect("a change that succeeded succeeds again from the same state");
+        }
+        *self.journal() = journal;
     }
 }
