@@ -105,39 +105,36 @@ impl Independent {
     }
 
     /// Advances every gear from t to t_end; with `at_impact` all stop at the first impact of
-    /// any gear, where its pair locates it: true if they did (t is then that instant). On
-    /// failure all are left as they were.
+    /// any gear, where its pair locates it: true if they did (t is then that instant). A
+    /// failure leaves the gears where it failed (the simulation's journal puts them back).
     pub fn advance(
         &mut self,
         t: &mut f64,
         t_end: f64,
         at_impact: bool,
     ) -> Result<bool, SolverError> {
-        let starts = self.pairs.clone();
-        match self.advance_all(&starts, *t, t_end, at_impact) {
-            Ok((reached, stopped)) => {
-                self.add_input_drag(*t, reached);
-                self.mirror();
-                *t = reached;
-                Ok(stopped)
-            }
-            Err(e) => {
-                self.pairs = starts;
-                Err(e)
-            }
-        }
+        let (reached, stopped) = self.advance_all(*t, t_end, at_impact)?;
+        self.add_input_drag(*t, reached);
+        self.mirror();
+        *t = reached;
+        Ok(stopped)
     }
 
-    /// Each pair in turn from `starts` at t0 to the earliest stop so far; a pair that stops
-    /// earlier takes the pairs before it back to its stop (none of them had an impact before
-    /// it). Returns the time all reached and whether it is an impact's.
+    /// Each pair in turn from t0 to the earliest stop so far; with `at_impact`, a pair that
+    /// stops earlier takes the pairs before it back to their starts and on to its stop (none
+    /// of them had an impact before it). Returns the time all reached and whether it is an
+    /// impact's.
     fn advance_all(
         &mut self,
-        starts: &[Pair],
         t0: f64,
         t_end: f64,
         at_impact: bool,
     ) -> Result<(f64, bool), SolverError> {
+        let starts = if at_impact {
+            self.pairs.clone()
+        } else {
+            Vec::new()
+        };
         let (mut stop, mut stopped) = (t_end, false);
         for i in 0..self.pairs.len() {
             let mut t = t0;
@@ -145,7 +142,7 @@ impl Independent {
                 continue;
             }
             if t < stop {
-                for (k, start) in self.pairs[..i].iter_mut().zip(starts) {
+                for (k, start) in self.pairs[..i].iter_mut().zip(&starts) {
                     let mut back = t0;
                     *k = *start;
                     k.advance(&mut back, t, false)?;

@@ -11,6 +11,7 @@ use crate::windowed::{self, Windowed};
 use fmi2_shell::values::Values;
 use fmi2_shell::{FmiError, FmiResult};
 use gear_rattle::gearbox::{self, Drive, Gearbox, GearboxParams, LooseGear, PHI, State, xi};
+use gear_rattle::instance::simulation::journal::{Journal, Journaled};
 use gear_rattle::instance::simulation::{Stepped, method};
 use gear_rattle::integrator::{Method, Solver, SolverError, Stats};
 use gear_rattle::physics::{
@@ -49,6 +50,27 @@ pub struct Simulation {
     /// Model Exchange: the importer integrates, the outputs take the pieces the states are
     /// in.
     pub model_exchange: bool,
+    /// What puts a failed step back: a copy of the run and the time, and the changes since.
+    #[serde(skip)]
+    journal: Journal<(Run, f64), Entry, ENTRIES>,
+}
+
+/// How many changes the journal records before it takes a new copy of the run (145 KB with
+/// the window open): a communication point served from the kept step is a change too, and
+/// the sound's grid has some 13 of them per integrator step (docs/DECISIONS.md D60).
+const ENTRIES: usize = 1024;
+
+/// A change of the simulation in co-simulation, as the journal records it.
+#[derive(Clone, Copy, Debug)]
+pub enum Entry {
+    /// A step from `from` to `to` ([`Simulation::step_until`]).
+    Step { from: f64, to: f64, at_impact: bool },
+    /// New flywheel inputs (excitation 0).
+    Flywheel(Shaft),
+    /// New input-side inputs (excitation 2).
+    InputSide(Shaft),
+    /// The output shaft's speed.
+    OutputSpeed(f64),
 }
 
 /// The gearbox's parameters as set: gears 1..n_gears from the per-gear arrays (C and c_I at
@@ -192,6 +214,7 @@ impl Simulation {
                 method,
                 interpolate_ends: false,
                 model_exchange,
+                journal: Journal::default(),
             });
         }
         let interpolate_ends = matches!(drive, Drive::Engine(_));
@@ -205,6 +228,7 @@ impl Simulation {
             method,
             interpolate_ends,
             model_exchange,
+            journal: Journal::default(),
         };
         if sim.window_from <= t0 {
             sim.open_window();
@@ -229,22 +253,28 @@ impl Simulation {
     /// end where it lies within the resolution of time of them: [`window::opening`]), with
     /// `at_impact` stopping at the first impact (contact onset) of any gear on the way, where
     /// the integrator locates it ([`Solver::advance_until`]); returns the time reached. On
-    /// failure the simulation is left as it was.
+    /// failure the simulation is left as it was (replayed by its [`Journal`]).
     pub fn step_until(&mut self, t_end: f64, at_impact: bool) -> Result<f64, SolverError> {
+        self.journaled(Entry::Step {
+            from: self.t,
+            to: t_end,
+            at_impact,
+        })
+    }
+
+    /// [`step_until`](Self::step_until) without the journal.
+    fn advance(&mut self, t_end: f64, at_impact: bool) -> Result<f64, SolverError> {
         let opening = match self.run {
             Run::Lean(_) => window::opening(self.window_from, self.t, t_end),
             _ => None,
         };
         let stopped = if let Some(from) = opening {
-            let before = self.clone();
-            let advanced = self.advance_until(from, at_impact).and_then(|stopped| {
-                if stopped {
-                    return Ok(true);
-                }
+            if self.advance_until(from, at_impact)? {
+                true
+            } else {
                 self.open_window();
-                self.advance_until(t_end, at_impact)
-            });
-            advanced.inspect_err(|_| *self = before)?
+                self.advance_until(t_end, at_impact)?
+            }
         } else {
             self.advance_until(t_end, at_impact)?
         };
@@ -316,30 +346,20 @@ impl Simulation {
     /// New flywheel inputs (excitation 0; ignored otherwise): φ and φ' follow at once.
     pub fn set_flywheel(&mut self, shaft: Shaft) {
         if matches!(self.gearbox().0.drive, Drive::Flywheel(_)) {
-            self.change_state(|g, t, y| {
-                g.set_flywheel(t, y, shaft);
-            });
+            self.change(Entry::Flywheel(shaft));
         }
     }
 
     /// New input-side inputs (excitation 2; ignored otherwise): the ξ_i follow at once.
     pub fn set_input_side(&mut self, shaft: Shaft) {
-        if let Run::Independent(p) = &mut self.run {
-            p.set_input_side(self.t, shaft);
-        } else if matches!(self.gearbox().0.drive, Drive::InputSide(_)) {
-            self.change_state(|g, t, y| {
-                g.set_input_side(t, y, shaft);
-            });
+        if matches!(self.gearbox().0.drive, Drive::InputSide(_)) {
+            self.change(Entry::InputSide(shaft));
         }
     }
 
     /// The output shaft's speed.
     pub fn set_output_speed(&mut self, omega_out: f64) {
-        if let Run::Independent(p) = &mut self.run {
-            p.set_output_speed(omega_out);
-        } else {
-            self.change_state(|g, _, _| g.set_output_speed(omega_out));
-        }
+        self.change(Entry::OutputSpeed(omega_out));
     }
 
     /// The imposed motion's extrapolation now (excitation 0: the flywheel's, 2: the input
@@ -362,5 +382,128 @@ impl Simulation {
 
     pub fn proposed_step(&self) -> f64 {
         on_run!(&self.run, k => k.solver.proposed_step(), p => p.proposed_step())
+    }
+}
+
+/// The gearbox's changes in co-simulation: steps and new inputs.
+impl Journaled<ENTRIES> for Simulation {
+    type Copy = (Run, f64);
+    type Entry = Entry;
+
+    fn journal(&mut self) -> &mut Journal<Self::Copy, Entry, ENTRIES> {
+        &mut self.journal
+    }
+
+    fn copy(&self) -> Self::Copy {
+        (self.run.clone(), self.t)
+    }
+
+    fn restore(&mut self, (run, t): &Self::Copy) {
+        (self.run, self.t) = (run.clone(), *t);
+    }
+
+    fn apply(&mut self, entry: Entry) -> Result<f64, SolverError> {
+        match entry {
+            Entry::Step {
+                from,
+                to,
+                at_impact,
+            } => {
+                self.t = from;
+                return self.advance(to, at_impact);
+            }
+            Entry::Flywheel(shaft) => self.change_state(|g, t, y| {
+                g.set_flywheel(t, y, shaft);
+            }),
+            Entry::InputSide(shaft) => match &mut self.run {
+                Run::Independent(p) => p.set_input_side(self.t, shaft),
+                _ => self.change_state(|g, t, y| {
+                    g.set_input_side(t, y, shaft);
+                }),
+            },
+            Entry::OutputSpeed(omega_out) => match &mut self.run {
+                Run::Independent(p) => p.set_output_speed(omega_out),
+                _ => self.change_state(|g, _, _| g.set_output_speed(omega_out)),
+            },
+        }
+        Ok(self.t)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A step that fails leaves the simulation as it was, run and solver compared whole, in
+    /// every kind of run: the coupled box (inputs, excitation 0) before its window opens, with
+    /// the window opening among the journaled steps and open from the start, and the gears
+    /// stepped apart (the input side, excitation 2);
+    /// after more steps than a journal records, with new inputs among them: its journal
+    /// replays them. The step fails on its first attempt, below the resolution of time, after
+    /// new inputs have made the solver evaluate the derivative there. It then goes on as if the
+    /// failed step had not been asked for.
+    #[test]
+    fn a_failed_step_leaves_the_simulation_as_it_was() {
+        // The excitation, where the window opens and the kind of run it ends in.
+        let cases = [
+            (EXCITATION_FLYWHEEL, 10.0, "Lean"),
+            (EXCITATION_FLYWHEEL, 5e-3, "Windowed"),
+            (EXCITATION_FLYWHEEL, 0.0, "Windowed"),
+            (EXCITATION_INPUT_SIDE, 2e-3, "Independent"),
+        ];
+        std::thread::Builder::new()
+            .stack_size(8 << 20)
+            .spawn(move || {
+                for (excitation, stats_from, kind) in cases {
+                    let case = format!("excitation {excitation}, window from {stats_from}");
+                    let mut values = Values::start(contract::VARIABLES);
+                    values.set_integer(vr::excitation, excitation);
+                    values.set_integer(vr::n_gears, 3);
+                    values.set_real(vr::omega_F, 84.0);
+                    values.set_real(vr::omega_I, 84.0);
+                    values.set_real(vr::stats_from, stats_from);
+                    let mut sim = Simulation::new(&values, 0.0, 1e-6, false).unwrap();
+                    let steps = ENTRIES + ENTRIES / 2;
+                    let inputs = |k: usize| Shaft {
+                        theta: 84.0 * k as f64 * 1e-4,
+                        omega: 84.0 + (k as f64 * 0.7).sin(),
+                        alpha: 0.0,
+                    };
+                    for k in 1..=steps {
+                        sim.step_until(k as f64 * 1e-4, false).unwrap();
+                        if k % 7 == 0 {
+                            sim.set_flywheel(inputs(k));
+                            sim.set_input_side(inputs(k));
+                            sim.set_output_speed(20.0 + k as f64 * 1e-2);
+                        }
+                    }
+                    let ran = match &sim.run {
+                        Run::Lean(_) => "Lean",
+                        Run::Windowed(_) => "Windowed",
+                        Run::Independent(_) => "Independent",
+                    };
+                    assert_eq!(ran, kind, "{case}");
+                    sim.set_output_speed(21.0);
+                    // More changes than the journal records: it holds those since its last copy.
+                    assert!(!sim.journal.is_empty() && sim.journal.len() < steps);
+                    let before = sim.clone();
+                    let t = sim.t;
+                    assert!(
+                        sim.step_until(t + 4.0 * f64::EPSILON * t, false).is_err(),
+                        "{case}"
+                    );
+                    assert!(sim == before, "{case}");
+                    assert_eq!(sim.stats(), before.stats(), "{case}");
+                    let mut unfailed = before;
+                    for k in steps + 1..=steps + 20 {
+                        sim.step_until(k as f64 * 1e-4, false).unwrap();
+                        unfailed.step_until(k as f64 * 1e-4, false).unwrap();
+                    }
+                    assert!(sim == unfailed, "{case}");
+                }
+            })
+            .unwrap()
+            .join()
+            .unwrap();
     }
 }

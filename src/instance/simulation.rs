@@ -19,9 +19,9 @@ use crate::rattle::torque::{self, TorqueRattle};
 use crate::rattle::window::{self, Metrics, Quadratures, Window};
 use crate::rattle::{self, GearPair, Impacts, KinematicRattle, LeanRattle, Rattle};
 use fmi2_shell::values::Values;
-use journal::{Entry, Journal};
+use journal::{ENTRIES, Entry, Journal, Journaled};
 
-mod journal;
+pub mod journal;
 mod readout;
 
 pub use readout::Readout;
@@ -54,32 +54,17 @@ pub struct Stepped<S, const N: usize> {
 }
 
 impl<S: Piecewise<N> + Jacobian<N> + Copy, const N: usize> Stepped<S, N> {
-    /// Advances to t_end; on failure the system, its solver and t are left as they were. A
-    /// call served from the solver's kept step cannot fail and needs no copy to roll back to
-    /// (at 10 µs communication steps most are).
-    pub fn advance_to(&mut self, t: &mut f64, t_end: f64) -> Result<(), SolverError> {
-        self.advance_until(t, t_end, |_| 0).map(|_| ())
-    }
-
-    /// [`advance_to`](Self::advance_to), stopping on the first edge crossed that raises the
-    /// system's count of `events` ([`Solver::advance_until`]): true if it stopped there.
+    /// Advances to t_end, stopping on the first edge crossed that raises the system's count
+    /// of `events` ([`Solver::advance_until`]): true if it stopped there. A failure leaves
+    /// the system where it failed (its simulation's [`Journal`] puts it back).
     pub fn advance_until(
         &mut self,
         t: &mut f64,
         t_end: f64,
         events: impl Fn(&S) -> u64,
     ) -> Result<bool, SolverError> {
-        if self.solver.serve(&mut self.system, t, &mut self.y, t_end) {
-            return Ok(false);
-        }
-        let (before, t_before) = (*self, *t);
-        let advanced = self
-            .solver
-            .advance_until(&mut self.system, t, &mut self.y, t_end, events);
-        if advanced.is_err() {
-            (*self, *t) = (before, t_before);
-        }
-        advanced
+        self.solver
+            .advance_until(&mut self.system, t, &mut self.y, t_end, events)
     }
 }
 
@@ -107,23 +92,12 @@ impl<S: GearPair<N> + Jacobian<N> + Copy, const N: usize> Stepped<S, N> {
         if let Some(from) = opening {
             // It opens there: what happens from then on is counted.
             self.system.window_mut().from = from;
-            if self.step(t, from, impacts)? {
+            if self.advance_until(t, from, impacts)? {
                 return Ok(true);
             }
             self.open_window();
         }
-        self.step(t, t_end, impacts)
-    }
-
-    /// The solver's call towards t_end, stopping at the first edge that raises `events`.
-    fn step(
-        &mut self,
-        t: &mut f64,
-        t_end: f64,
-        events: impl Fn(&S) -> u64,
-    ) -> Result<bool, SolverError> {
-        self.solver
-            .advance_until(&mut self.system, t, &mut self.y, t_end, events)
+        self.advance_until(t, t_end, impacts)
     }
 
     /// The pair at t0 with the state's first components `head` (the quadratures from 0) and
@@ -258,7 +232,7 @@ pub struct Simulation {
     pub drive: Drive,
     /// What puts a failed step back (see `journal`).
     #[serde(skip)]
-    journal: Journal,
+    journal: Journal<(Gear, f64, Drive), Entry, ENTRIES>,
 }
 
 /// What every output is computed from at the current time, whichever the coupling (the
@@ -454,9 +428,7 @@ impl Simulation {
     /// the new inputs (direct feedthrough). In the other modes the inputs are not used.
     pub fn set_shaft(&mut self, shaft: Shaft) {
         if let Drive::Inputs(_) = self.drive {
-            self.journal.before(&self.gear, self.t, &self.drive);
-            self.apply_shaft(shaft);
-            self.journal.record(Entry::Shaft(shaft));
+            self.change(Entry::Shaft(shaft));
         }
     }
 
@@ -474,9 +446,7 @@ impl Simulation {
     /// does not jump: only the shaft's acceleration, read at once as alpha_M_out, changes.
     pub fn set_torque(&mut self, tau: f64, rate: f64) {
         if let Drive::Torque { .. } = self.drive {
-            self.journal.before(&self.gear, self.t, &self.drive);
-            self.apply_torque(tau, rate);
-            self.journal.record(Entry::Torque { tau, rate });
+            self.change(Entry::Torque { tau, rate });
         }
     }
 
@@ -502,46 +472,11 @@ impl Simulation {
     /// the integrator locates it); returns the time reached. On failure the simulation is
     /// left as it was (replayed by its [`Journal`]).
     pub fn step_until(&mut self, t_end: f64, at_impact: bool) -> Result<f64, SolverError> {
-        self.journal.before(&self.gear, self.t, &self.drive);
-        let from = self.t;
-        match self.advance(t_end, at_impact) {
-            Ok(reached) => {
-                self.journal.record(Entry::Step {
-                    from,
-                    to: t_end,
-                    at_impact,
-                });
-                Ok(reached)
-            }
-            Err(e) => {
-                self.replay();
-                Err(e)
-            }
-        }
-    }
-
-    /// Back to the state before the step that failed: the journal's copy, then the changes
-    /// made since.
-    #[cold]
-    fn replay(&mut self) {
-        let journal = self.journal;
-        let ((gear, t, drive), entries) = journal.replay();
-        (self.gear, self.t, self.drive) = (gear, t, drive);
-        for entry in entries {
-            match *entry {
-                Entry::Step {
-                    from,
-                    to,
-                    at_impact,
-                } => {
-                    self.t = from;
-                    self.advance(to, at_impact)
-                        .expect("a step that succeeded succeeds again from the same state");
-                }
-                Entry::Shaft(shaft) => self.apply_shaft(shaft),
-                Entry::Torque { tau, rate } => self.apply_torque(tau, rate),
-            }
-        }
+        self.journaled(Entry::Step {
+            from: self.t,
+            to: t_end,
+            at_impact,
+        })
     }
 
     /// [`step_until`](Self::step_until) without the journal: a failure leaves the simulation
@@ -655,6 +590,40 @@ impl Simulation {
             }
             _ => return stat_integer(&now.metrics(self.t), vr),
         })
+    }
+}
+
+/// GearRattle's changes in co-simulation: steps and new inputs.
+impl Journaled<ENTRIES> for Simulation {
+    type Copy = (Gear, f64, Drive);
+    type Entry = Entry;
+
+    fn journal(&mut self) -> &mut Journal<Self::Copy, Entry, ENTRIES> {
+        &mut self.journal
+    }
+
+    fn copy(&self) -> Self::Copy {
+        (self.gear, self.t, self.drive)
+    }
+
+    fn restore(&mut self, copy: &Self::Copy) {
+        (self.gear, self.t, self.drive) = *copy;
+    }
+
+    fn apply(&mut self, entry: Entry) -> Result<f64, SolverError> {
+        match entry {
+            Entry::Step {
+                from,
+                to,
+                at_impact,
+            } => {
+                self.t = from;
+                return self.advance(to, at_impact);
+            }
+            Entry::Shaft(shaft) => self.apply_shaft(shaft),
+            Entry::Torque { tau, rate } => self.apply_torque(tau, rate),
+        }
+        Ok(self.t)
     }
 }
 
@@ -837,7 +806,7 @@ mod tests {
             values.set_real(vr::tau_in, 0.5);
             values.set_real(vr::stats_from, 2e-3);
             let mut sim = Simulation::new(&values, 0.0, 0.0, 1e-6, Carry::Asked).unwrap();
-            let steps = journal::ENTRIES + journal::ENTRIES / 2;
+            let steps = ENTRIES + ENTRIES / 2;
             for k in 1..=steps {
                 sim.step_to(k as f64 * 1e-4).unwrap();
                 // New inputs now and then (each mode takes its own).
@@ -850,7 +819,7 @@ mod tests {
                     sim.set_torque(0.5 + k as f64 * 1e-3, 2.0);
                 }
             }
-            assert!(sim.journal.len() > 0 && sim.journal.len() < steps / 2);
+            assert!(!sim.journal.is_empty() && sim.journal.len() < steps / 2);
             let before = sim;
             let t = sim.t;
             assert!(sim.step_to(t + 4.0 * f64::EPSILON * t).is_err());

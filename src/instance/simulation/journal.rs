@@ -1,19 +1,20 @@
-//! What puts a failed step of a [`Simulation`](super::Simulation) back as it was, for the
-//! price of one copy of the simulation every [`ENTRIES`] changes instead of one before each
-//! step: the copy, and the changes made since (each step's start, end time and `at_impact`,
-//! each new input). Replayed from the copy, they give the state before the failed step to
-//! the bit: a step depends on nothing else. Model Exchange, which moves the state from
-//! outside, never steps.
+//! What puts a failed step of a simulation back as it was, for the price of one copy of the
+//! simulation every `ENTRIES` changes instead of one before each step: the copy, and the
+//! changes made since (each step's start, end time and `at_impact`, each new input).
+//! Replayed from the copy, they give the state before the failed step to the bit: a step
+//! depends on nothing else. Model Exchange, which moves the state from outside, never steps.
+//! A simulation makes its changes through [`Journaled`]: GearRattle's
+//! [`Simulation`](super::Simulation) with [`Entry`]s, GearboxRattle's with its own.
 
-use super::{Drive, Gear};
+use crate::integrator::SolverError;
 use crate::physics::Shaft;
 
-/// How many changes a journal records before it takes a new copy.
-pub(super) const ENTRIES: usize = 64;
+/// How many changes GearRattle's journal records before it takes a new copy.
+pub const ENTRIES: usize = 64;
 
-/// A change of the simulation since the journal's copy, in the order made.
+/// A change of GearRattle's simulation since the journal's copy, in the order made.
 #[derive(Clone, Copy, Debug)]
-pub(super) enum Entry {
+pub enum Entry {
     /// A step from `from` to `to` that succeeded (`Simulation::step_until`).
     Step { from: f64, to: f64, at_impact: bool },
     /// New inputs of the main shaft (`Simulation::set_shaft`).
@@ -22,62 +23,135 @@ pub(super) enum Entry {
     Torque { tau: f64, rate: f64 },
 }
 
-/// The copy and the changes since; no part of the simulation's state (not serialized, not
-/// compared).
+/// The copy `C` of what a simulation's changes move, and the changes `E` since; no part of
+/// the simulation's state (not serialized, not compared).
 #[derive(Clone, Copy, Debug)]
-pub(super) struct Journal {
-    copy: Option<(Gear, f64, Drive)>,
-    entries: [Entry; ENTRIES],
+pub struct Journal<C, E, const ENTRIES: usize> {
+    copy: Option<C>,
+    entries: [Option<E>; ENTRIES],
     len: usize,
 }
 
-impl Default for Journal {
+impl<C, E: Copy, const ENTRIES: usize> Default for Journal<C, E, ENTRIES> {
     fn default() -> Self {
         Journal {
             copy: None,
-            entries: [Entry::Torque {
-                tau: 0.0,
-                rate: 0.0,
-            }; ENTRIES],
+            entries: [None; ENTRIES],
             len: 0,
         }
     }
 }
 
 /// Two simulations in the same state are equal whatever their journals.
-impl PartialEq for Journal {
+impl<C, E, const ENTRIES: usize> PartialEq for Journal<C, E, ENTRIES> {
     fn eq(&self, _: &Self) -> bool {
         true
     }
 }
 
-impl Journal {
-    /// Before a change of the simulation (gear, t, drive): a new copy of it if the journal
-    /// has none or is full.
+impl<C, E: Copy, const ENTRIES: usize> Journal<C, E, ENTRIES> {
+    /// Whether the next change needs a new copy first: the journal has none or is full.
     #[inline]
-    pub(super) fn before(&mut self, gear: &Gear, t: f64, drive: &Drive) {
-        if self.copy.is_none() || self.len == ENTRIES {
-            self.copy = Some((*gear, t, *drive));
-            self.len = 0;
-        }
+    fn is_due(&self) -> bool {
+        self.copy.is_none() || self.len == ENTRIES
     }
 
-    /// After the change `entry`, made since [`before`](Self::before).
+    /// A new copy, taken before the next change, and no changes since.
+    fn start(&mut self, copy: C) {
+        self.copy = Some(copy);
+        self.len = 0;
+    }
+
+    /// After the change `entry`, made since the copy.
     #[inline]
-    pub(super) fn record(&mut self, entry: Entry) {
-        self.entries[self.len] = entry;
+    fn record(&mut self, entry: E) {
+        self.entries[self.len] = Some(entry);
         self.len += 1;
     }
 
-    /// The copy and the changes since it.
-    pub(super) fn replay(&self) -> ((Gear, f64, Drive), &[Entry]) {
-        let copy = self.copy.expect("taken before the first change");
-        (copy, &self.entries[..self.len])
+    /// The copy and the changes since it, in the order made.
+    fn replay(&self) -> (&C, impl Iterator<Item = E> + '_) {
+        let copy = self.copy.as_ref().expect("taken before the first change");
+        (copy, self.entries[..self.len].iter().flatten().copied())
     }
 
     /// How many changes it holds.
-    #[cfg(test)]
-    pub(super) fn len(&self) -> usize {
+    pub fn len(&self) -> usize {
         self.len
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+}
+
+/// A simulation whose changes a journal of `ENTRIES` records: each change made through
+/// [`journaled`](Self::journaled), a failed one put back by [`replay`](Self::replay).
+pub trait Journaled<const ENTRIES: usize> {
+    /// What the journal copies: what the changes move.
+    type Copy;
+    /// A change.
+    type Entry: Copy;
+
+    fn journal(&mut self) -> &mut Journal<Self::Copy, Self::Entry, ENTRIES>;
+
+    /// A copy of what the changes move.
+    fn copy(&self) -> Self::Copy;
+
+    /// Back to `copy`.
+    fn restore(&mut self, copy: &Self::Copy);
+
+    /// Makes the change `entry` without the journal: a failed step leaves the simulation
+    /// where it failed. Returns the time reached.
+    fn apply(&mut self, entry: Self::Entry) -> Result<f64, SolverError>;
+
+    /// Makes the change `entry` and records it; if it fails (a step), puts the simulation
+    /// back as it was before. Returns the time reached.
+    #[inline]
+    fn journaled(&mut self, entry: Self::Entry) -> Result<f64, SolverError>
+    where
+        Self: Sized,
+    {
+        if self.journal().is_due() {
+            let copy = self.copy();
+            self.journal().start(copy);
+        }
+        match self.apply(entry) {
+            Ok(reached) => {
+                self.journal().record(entry);
+                Ok(reached)
+            }
+            Err(e) => {
+                self.replay();
+                Err(e)
+            }
+        }
+    }
+
+    /// Makes a change that cannot fail (new inputs) and records it.
+    fn change(&mut self, entry: Self::Entry)
+    where
+        Self: Sized,
+    {
+        self.journaled(entry)
+            .expect("a change of inputs does not step");
+    }
+
+    /// Back to the state before the change that failed: the journal's copy, then the
+    /// changes made since.
+    #[cold]
+    fn replay(&mut self)
+    where
+        Self: Sized,
+    {
+        let mut journal = Journal::default();
+        std::mem::swap(self.journal(), &mut journal);
+        let (copy, entries) = journal.replay();
+        self.restore(copy);
+        for entry in entries {
+            self.apply(entry)
+                .expect("a change that succeeded succeeds again from the same state");
+        }
+        *self.journal() = journal;
     }
 }
