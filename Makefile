@@ -22,8 +22,9 @@ CRATES := $(foreach m,$(MODELS),$(crate_$(m)))
 FMU_DEBUG := target/fmu/debug
 FMU_STRIPPED := target/fmu/stripped
 # The tests and packaging build in cargo's `quick` profile (Cargo.toml): release's optimization
-# without its LTO, which is for the FMUs' binaries alone.
-CARGO_TEST := cargo test --profile quick
+# without its LTO, which is for the FMUs' binaries alone. cargo and rustdoc are not told of
+# make's jobserver: under make test's -j2 the recipe cannot reach it (mk/hardening.mk's fuzz).
+CARGO_TEST := MAKEFLAGS= cargo test --profile quick
 PACKAGE := cargo run --profile quick --quiet -p packaging --bin package --
 # Fragments in mk/ (one per capability: windows, benchmarks, rattle map) add to these;
 # FMU_PLATFORMS: the platforms of the FMUs' binaries as PLATFORM:EXTENSION (linux64:so...).
