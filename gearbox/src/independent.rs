@@ -104,20 +104,20 @@ impl Independent {
         }
     }
 
-    /// Advances every gear from t to t_end; with `at_impact` all stop at the first impact of
-    /// any gear, where its pair locates it: true if they did (t is then that instant). A
-    /// failure leaves the gears where it failed (the simulation's journal puts them back).
+    /// Advances every gear from t0 to t_end; with `at_impact` all stop at the first impact of
+    /// any gear, where its pair locates it. Returns the time they reached and whether it is an
+    /// impact's. A failure leaves the gears where it failed (the simulation's journal puts
+    /// them back).
     pub fn advance(
         &mut self,
-        t: &mut f64,
+        t0: f64,
         t_end: f64,
         at_impact: bool,
-    ) -> Result<bool, SolverError> {
-        let (reached, stopped) = self.advance_all(*t, t_end, at_impact)?;
-        self.add_input_drag(*t, reached);
+    ) -> Result<(f64, bool), SolverError> {
+        let (reached, stopped) = self.advance_all(t0, t_end, at_impact)?;
+        self.add_input_drag(t0, reached);
         self.mirror();
-        *t = reached;
-        Ok(stopped)
+        Ok((reached, stopped))
     }
 
     /// Each pair in turn from t0 to the earliest stop so far; with `at_impact`, a pair that

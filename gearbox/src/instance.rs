@@ -12,6 +12,7 @@ use fmi2_shell::{
     Continuous, Core, EventInfo, FmiError, FmiResult, FmiState, Identity, Interface, Model, Slave,
     Status, Stepping,
 };
+use gear_rattle::instance::Journaled;
 use gear_rattle::integrator::SolverError;
 
 /// One FMU instance. Everything but the log is its FMU state: parameters, inputs, the

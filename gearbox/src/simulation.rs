@@ -11,7 +11,7 @@ use crate::windowed::{self, Windowed};
 use fmi2_shell::values::Values;
 use fmi2_shell::{FmiError, FmiResult};
 use gear_rattle::gearbox::{self, Drive, Gearbox, GearboxParams, LooseGear, PHI, State, xi};
-use gear_rattle::instance::simulation::journal::{Journal, Journaled};
+use gear_rattle::instance::simulation::journal::{Change, Journal, Journaled};
 use gear_rattle::instance::simulation::{Stepped, method};
 use gear_rattle::integrator::{Method, Solver, SolverError, Stats};
 use gear_rattle::physics::{
@@ -52,7 +52,7 @@ pub struct Simulation {
     pub model_exchange: bool,
     /// What puts a failed step back: a copy of the run and the time, and the changes since.
     #[serde(skip)]
-    journal: Journal<(Run, f64), Entry, ENTRIES>,
+    journal: Journal<(Run, f64), Change<Input>, ENTRIES>,
 }
 
 /// How many changes the journal records before it takes a new copy of the run (145 KB with
@@ -60,11 +60,9 @@ pub struct Simulation {
 /// the sound's grid has some 13 of them per integrator step (docs/DECISIONS.md D60).
 const ENTRIES: usize = 1024;
 
-/// A change of the simulation in co-simulation, as the journal records it.
+/// New inputs of the simulation in co-simulation, as the journal records them.
 #[derive(Clone, Copy, Debug)]
-pub enum Entry {
-    /// A step from `from` to `to` ([`Simulation::step_until`]).
-    Step { from: f64, to: f64, at_impact: bool },
+pub enum Input {
     /// New flywheel inputs (excitation 0).
     Flywheel(Shaft),
     /// New input-side inputs (excitation 2).
@@ -249,48 +247,17 @@ impl Simulation {
         self.run = Run::Windowed(Box::new(Stepped { system, solver, y }));
     }
 
-    /// Advances to t_end, through the window's opening on the way (on the call's start or
-    /// end where it lies within the resolution of time of them: [`window::opening`]), with
-    /// `at_impact` stopping at the first impact (contact onset) of any gear on the way, where
-    /// the integrator locates it ([`Solver::advance_until`]); returns the time reached. On
-    /// failure the simulation is left as it was (replayed by its [`Journal`]).
-    pub fn step_until(&mut self, t_end: f64, at_impact: bool) -> Result<f64, SolverError> {
-        self.journaled(Entry::Step {
-            from: self.t,
-            to: t_end,
-            at_impact,
-        })
-    }
-
-    /// [`step_until`](Self::step_until) without the journal.
-    fn advance(&mut self, t_end: f64, at_impact: bool) -> Result<f64, SolverError> {
-        let opening = match self.run {
-            Run::Lean(_) => window::opening(self.window_from, self.t, t_end),
-            _ => None,
-        };
-        let stopped = if let Some(from) = opening {
-            if self.advance_until(from, at_impact)? {
-                true
-            } else {
-                self.open_window();
-                self.advance_until(t_end, at_impact)?
-            }
-        } else {
-            self.advance_until(t_end, at_impact)?
-        };
-        if !stopped {
-            self.t = t_end;
-        }
-        Ok(self.t)
-    }
-
     /// The run's advance to t_end, stopping at an impact if `at_impact`: true if it did.
     fn advance_until(&mut self, t_end: f64, at_impact: bool) -> Result<bool, SolverError> {
         let on = u64::from(at_impact);
         match &mut self.run {
             Run::Lean(k) => k.advance_until(&mut self.t, t_end, |g| on * impacts(g)),
             Run::Windowed(k) => k.advance_until(&mut self.t, t_end, |w| on * impacts(&w.inner)),
-            Run::Independent(p) => p.advance(&mut self.t, t_end, at_impact),
+            Run::Independent(p) => {
+                let (reached, stopped) = p.advance(self.t, t_end, at_impact)?;
+                self.t = reached;
+                Ok(stopped)
+            }
         }
     }
 
@@ -346,20 +313,20 @@ impl Simulation {
     /// New flywheel inputs (excitation 0; ignored otherwise): φ and φ' follow at once.
     pub fn set_flywheel(&mut self, shaft: Shaft) {
         if matches!(self.gearbox().0.drive, Drive::Flywheel(_)) {
-            self.change(Entry::Flywheel(shaft));
+            self.change(Input::Flywheel(shaft));
         }
     }
 
     /// New input-side inputs (excitation 2; ignored otherwise): the ξ_i follow at once.
     pub fn set_input_side(&mut self, shaft: Shaft) {
         if matches!(self.gearbox().0.drive, Drive::InputSide(_)) {
-            self.change(Entry::InputSide(shaft));
+            self.change(Input::InputSide(shaft));
         }
     }
 
     /// The output shaft's speed.
     pub fn set_output_speed(&mut self, omega_out: f64) {
-        self.change(Entry::OutputSpeed(omega_out));
+        self.change(Input::OutputSpeed(omega_out));
     }
 
     /// The imposed motion's extrapolation now (excitation 0: the flywheel's, 2: the input
@@ -388,9 +355,9 @@ impl Simulation {
 /// The gearbox's changes in co-simulation: steps and new inputs.
 impl Journaled<ENTRIES> for Simulation {
     type Copy = (Run, f64);
-    type Entry = Entry;
+    type Input = Input;
 
-    fn journal(&mut self) -> &mut Journal<Self::Copy, Entry, ENTRIES> {
+    fn journal(&mut self) -> &mut Journal<Self::Copy, Change<Input>, ENTRIES> {
         &mut self.journal
     }
 
@@ -402,31 +369,50 @@ impl Journaled<ENTRIES> for Simulation {
         (self.run, self.t) = (run.clone(), *t);
     }
 
-    fn apply(&mut self, entry: Entry) -> Result<f64, SolverError> {
-        match entry {
-            Entry::Step {
-                from,
-                to,
-                at_impact,
-            } => {
-                self.t = from;
-                return self.advance(to, at_impact);
+    fn time(&mut self) -> &mut f64 {
+        &mut self.t
+    }
+
+    /// Through the window's opening on the way (on the call's start or end where it lies
+    /// within the resolution of time of them: [`window::opening`]); with `at_impact` the
+    /// first impact is that of any gear.
+    fn advance(&mut self, t_end: f64, at_impact: bool) -> Result<f64, SolverError> {
+        let opening = match self.run {
+            Run::Lean(_) => window::opening(self.window_from, self.t, t_end),
+            _ => None,
+        };
+        let stopped = if let Some(from) = opening {
+            if self.advance_until(from, at_impact)? {
+                true
+            } else {
+                self.open_window();
+                self.advance_until(t_end, at_impact)?
             }
-            Entry::Flywheel(shaft) => self.change_state(|g, t, y| {
+        } else {
+            self.advance_until(t_end, at_impact)?
+        };
+        if !stopped {
+            self.t = t_end;
+        }
+        Ok(self.t)
+    }
+
+    fn take(&mut self, input: Input) {
+        match input {
+            Input::Flywheel(shaft) => self.change_state(|g, t, y| {
                 g.set_flywheel(t, y, shaft);
             }),
-            Entry::InputSide(shaft) => match &mut self.run {
+            Input::InputSide(shaft) => match &mut self.run {
                 Run::Independent(p) => p.set_input_side(self.t, shaft),
                 _ => self.change_state(|g, t, y| {
                     g.set_input_side(t, y, shaft);
                 }),
             },
-            Entry::OutputSpeed(omega_out) => match &mut self.run {
+            Input::OutputSpeed(omega_out) => match &mut self.run {
                 Run::Independent(p) => p.set_output_speed(omega_out),
                 _ => self.change_state(|g, _, _| g.set_output_speed(omega_out)),
             },
         }
-        Ok(self.t)
     }
 }
 

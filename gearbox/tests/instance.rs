@@ -4,6 +4,7 @@
 
 use fmi2_shell::fmu_state::{deserialize, serialize};
 use fmi2_shell::{FmiState, Fmu, Interface, Slave};
+use gear_rattle::instance::Journaled;
 use gearbox_rattle::contract::{Causality, Kind, VARIABLES, vr};
 use gearbox_rattle::instance::Instance;
 

@@ -8,7 +8,7 @@ pub mod model_exchange;
 pub mod simulation;
 
 pub use fmi2_shell::{FmiError, FmiResult, FmiState, Status};
-pub use simulation::{Carry, Readout, Simulation};
+pub use simulation::{Carry, Journaled, Readout, Simulation};
 
 use crate::contract::{self, Causality, Kind, LOG_CATEGORIES, vr};
 use crate::integrator::SolverError;

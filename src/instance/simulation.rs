@@ -19,11 +19,12 @@ use crate::rattle::torque::{self, TorqueRattle};
 use crate::rattle::window::{self, Metrics, Quadratures, Window};
 use crate::rattle::{self, GearPair, Impacts, KinematicRattle, LeanRattle, Rattle};
 use fmi2_shell::values::Values;
-use journal::{ENTRIES, Entry, Journal, Journaled};
+use journal::{Change, ENTRIES, Input, Journal};
 
 pub mod journal;
 mod readout;
 
+pub use journal::Journaled;
 pub use readout::Readout;
 
 /// Values of the `excitation` parameter.
@@ -232,7 +233,7 @@ pub struct Simulation {
     pub drive: Drive,
     /// What puts a failed step back (see `journal`).
     #[serde(skip)]
-    journal: Journal<(Gear, f64, Drive), Entry, ENTRIES>,
+    journal: Journal<(Gear, f64, Drive), Change<Input>, ENTRIES>,
 }
 
 /// What every output is computed from at the current time, whichever the coupling (the
@@ -428,7 +429,7 @@ impl Simulation {
     /// the new inputs (direct feedthrough). In the other modes the inputs are not used.
     pub fn set_shaft(&mut self, shaft: Shaft) {
         if let Drive::Inputs(_) = self.drive {
-            self.change(Entry::Shaft(shaft));
+            self.change(Input::Shaft(shaft));
         }
     }
 
@@ -446,7 +447,7 @@ impl Simulation {
     /// does not jump: only the shaft's acceleration, read at once as alpha_M_out, changes.
     pub fn set_torque(&mut self, tau: f64, rate: f64) {
         if let Drive::Torque { .. } = self.drive {
-            self.change(Entry::Torque { tau, rate });
+            self.change(Input::Torque { tau, rate });
         }
     }
 
@@ -466,36 +467,6 @@ impl Simulation {
     /// Advances to t_end. On failure the simulation is left as it was.
     pub fn step_to(&mut self, t_end: f64) -> Result<(), SolverError> {
         self.step_until(t_end, false).map(|_| ())
-    }
-
-    /// Advances to t_end, or with `at_impact` to the first impact before it (its instant as
-    /// the integrator locates it); returns the time reached. On failure the simulation is
-    /// left as it was (replayed by its [`Journal`]).
-    pub fn step_until(&mut self, t_end: f64, at_impact: bool) -> Result<f64, SolverError> {
-        self.journaled(Entry::Step {
-            from: self.t,
-            to: t_end,
-            at_impact,
-        })
-    }
-
-    /// [`step_until`](Self::step_until) without the journal: a failure leaves the simulation
-    /// where it failed.
-    fn advance(&mut self, t_end: f64, at_impact: bool) -> Result<f64, SolverError> {
-        let stopped = on_gear!(&mut self.gear, k => k.advance(&mut self.t, t_end, at_impact)?);
-        if !stopped {
-            self.t = t_end;
-        }
-        let t = self.t;
-        // The inputs continue along their extrapolation unless the master sets new ones.
-        match &mut self.drive {
-            Drive::Inputs(shaft) => by_coupling!(&self.gear,
-                kinematic k => *shaft = k.system.excitation.at(t), torque _ => {}),
-            Drive::Torque { tau, .. } => by_coupling!(&self.gear,
-                kinematic _ => {}, torque k => *tau = k.system.torque.at(t)),
-            Drive::Sine(_) => {}
-        }
-        Ok(t)
     }
 
     /// The value of a Real output read in co-simulation, computed now; None if `vr` is not a
@@ -596,9 +567,9 @@ impl Simulation {
 /// GearRattle's changes in co-simulation: steps and new inputs.
 impl Journaled<ENTRIES> for Simulation {
     type Copy = (Gear, f64, Drive);
-    type Entry = Entry;
+    type Input = Input;
 
-    fn journal(&mut self) -> &mut Journal<Self::Copy, Entry, ENTRIES> {
+    fn journal(&mut self) -> &mut Journal<Self::Copy, Change<Input>, ENTRIES> {
         &mut self.journal
     }
 
@@ -610,20 +581,32 @@ impl Journaled<ENTRIES> for Simulation {
         (self.gear, self.t, self.drive) = *copy;
     }
 
-    fn apply(&mut self, entry: Entry) -> Result<f64, SolverError> {
-        match entry {
-            Entry::Step {
-                from,
-                to,
-                at_impact,
-            } => {
-                self.t = from;
-                return self.advance(to, at_impact);
-            }
-            Entry::Shaft(shaft) => self.apply_shaft(shaft),
-            Entry::Torque { tau, rate } => self.apply_torque(tau, rate),
+    fn time(&mut self) -> &mut f64 {
+        &mut self.t
+    }
+
+    fn advance(&mut self, t_end: f64, at_impact: bool) -> Result<f64, SolverError> {
+        let stopped = on_gear!(&mut self.gear, k => k.advance(&mut self.t, t_end, at_impact)?);
+        if !stopped {
+            self.t = t_end;
         }
-        Ok(self.t)
+        let t = self.t;
+        // The inputs continue along their extrapolation unless the master sets new ones.
+        match &mut self.drive {
+            Drive::Inputs(shaft) => by_coupling!(&self.gear,
+                kinematic k => *shaft = k.system.excitation.at(t), torque _ => {}),
+            Drive::Torque { tau, .. } => by_coupling!(&self.gear,
+                kinematic _ => {}, torque k => *tau = k.system.torque.at(t)),
+            Drive::Sine(_) => {}
+        }
+        Ok(t)
+    }
+
+    fn take(&mut self, input: Input) {
+        match input {
+            Input::Shaft(shaft) => self.apply_shaft(shaft),
+            Input::Torque { tau, rate } => self.apply_torque(tau, rate),
+        }
     }
 }
 

@@ -4,7 +4,7 @@
 //! Replayed from the copy, they give the state before the failed step to the bit: a step
 //! depends on nothing else. Model Exchange, which moves the state from outside, never steps.
 //! A simulation makes its changes through [`Journaled`]: GearRattle's
-//! [`Simulation`](super::Simulation) with [`Entry`]s, GearboxRattle's with its own.
+//! [`Simulation`](super::Simulation) with its [`Input`]s, GearboxRattle's with its own.
 
 use crate::integrator::SolverError;
 use crate::physics::Shaft;
@@ -12,14 +12,22 @@ use crate::physics::Shaft;
 /// How many changes GearRattle's journal records before it takes a new copy.
 pub const ENTRIES: usize = 64;
 
-/// A change of GearRattle's simulation since the journal's copy, in the order made.
+/// A change of a simulation since the journal's copy, in the order made: a step, or new
+/// inputs `I` of the model's own kind.
 #[derive(Clone, Copy, Debug)]
-pub enum Entry {
-    /// A step from `from` to `to` that succeeded (`Simulation::step_until`).
+pub enum Change<I> {
+    /// A step from `from` to `to` that succeeded ([`Journaled::step_until`]).
     Step { from: f64, to: f64, at_impact: bool },
-    /// New inputs of the main shaft (`Simulation::set_shaft`).
+    /// New inputs.
+    Input(I),
+}
+
+/// New inputs of GearRattle's simulation.
+#[derive(Clone, Copy, Debug)]
+pub enum Input {
+    /// Of the main shaft (`Simulation::set_shaft`).
     Shaft(Shaft),
-    /// A new torque on the main shaft (`Simulation::set_torque`).
+    /// A torque on the main shaft (`Simulation::set_torque`).
     Torque { tau: f64, rate: f64 },
 }
 
@@ -85,15 +93,16 @@ impl<C, E: Copy, const ENTRIES: usize> Journal<C, E, ENTRIES> {
     }
 }
 
-/// A simulation whose changes a journal of `ENTRIES` records: each change made through
-/// [`journaled`](Self::journaled), a failed one put back by [`replay`](Self::replay).
+/// A simulation whose changes a journal of `ENTRIES` records: each step and each new input
+/// made through it ([`step_until`](Self::step_until), [`change`](Self::change)), a failed
+/// step put back by [`replay`](Self::replay).
 pub trait Journaled<const ENTRIES: usize> {
     /// What the journal copies: what the changes move.
     type Copy;
-    /// A change.
-    type Entry: Copy;
+    /// New inputs.
+    type Input: Copy;
 
-    fn journal(&mut self) -> &mut Journal<Self::Copy, Self::Entry, ENTRIES>;
+    fn journal(&mut self) -> &mut Journal<Self::Copy, Change<Self::Input>, ENTRIES>;
 
     /// A copy of what the changes move.
     fn copy(&self) -> Self::Copy;
@@ -101,14 +110,63 @@ pub trait Journaled<const ENTRIES: usize> {
     /// Back to `copy`.
     fn restore(&mut self, copy: &Self::Copy);
 
-    /// Makes the change `entry` without the journal: a failed step leaves the simulation
-    /// where it failed. Returns the time reached.
-    fn apply(&mut self, entry: Self::Entry) -> Result<f64, SolverError>;
+    /// The simulation's time.
+    fn time(&mut self) -> &mut f64;
 
-    /// Makes the change `entry` and records it; if it fails (a step), puts the simulation
-    /// back as it was before. Returns the time reached.
+    /// Advances from the simulation's time to t_end without the journal, with `at_impact`
+    /// stopping at the first impact before it: returns the time reached. A failure leaves
+    /// the simulation where it failed.
+    fn advance(&mut self, t_end: f64, at_impact: bool) -> Result<f64, SolverError>;
+
+    /// Takes new inputs without the journal.
+    fn take(&mut self, input: Self::Input);
+
+    /// Advances to t_end, or with `at_impact` to the first impact before it (its instant as
+    /// the integrator locates it); returns the time reached. On failure the simulation is
+    /// left as it was.
+    fn step_until(&mut self, t_end: f64, at_impact: bool) -> Result<f64, SolverError>
+    where
+        Self: Sized,
+    {
+        let from = *self.time();
+        self.journaled(Change::Step {
+            from,
+            to: t_end,
+            at_impact,
+        })
+    }
+
+    /// Takes new inputs and records them.
+    fn change(&mut self, input: Self::Input)
+    where
+        Self: Sized,
+    {
+        self.journaled(Change::Input(input))
+            .expect("a change of inputs does not step");
+    }
+
+    /// Makes the change without the journal; returns the time reached.
+    fn apply(&mut self, change: Change<Self::Input>) -> Result<f64, SolverError> {
+        match change {
+            Change::Step {
+                from,
+                to,
+                at_impact,
+            } => {
+                *self.time() = from;
+                self.advance(to, at_impact)
+            }
+            Change::Input(input) => {
+                self.take(input);
+                Ok(*self.time())
+            }
+        }
+    }
+
+    /// Makes the change and records it; if it fails (a step), puts the simulation back as
+    /// it was before. Returns the time reached.
     #[inline]
-    fn journaled(&mut self, entry: Self::Entry) -> Result<f64, SolverError>
+    fn journaled(&mut self, change: Change<Self::Input>) -> Result<f64, SolverError>
     where
         Self: Sized,
     {
@@ -116,9 +174,9 @@ pub trait Journaled<const ENTRIES: usize> {
             let copy = self.copy();
             self.journal().start(copy);
         }
-        match self.apply(entry) {
+        match self.apply(change) {
             Ok(reached) => {
-                self.journal().record(entry);
+                self.journal().record(change);
                 Ok(reached)
             }
             Err(e) => {
@@ -126,15 +184,6 @@ pub trait Journaled<const ENTRIES: usize> {
                 Err(e)
             }
         }
-    }
-
-    /// Makes a change that cannot fail (new inputs) and records it.
-    fn change(&mut self, entry: Self::Entry)
-    where
-        Self: Sized,
-    {
-        self.journaled(entry)
-            .expect("a change of inputs does not step");
     }
 
     /// Back to the state before the change that failed: the journal's copy, then the
@@ -148,8 +197,8 @@ pub trait Journaled<const ENTRIES: usize> {
         std::mem::swap(self.journal(), &mut journal);
         let (copy, entries) = journal.replay();
         self.restore(copy);
-        for entry in entries {
-            self.apply(entry)
+        for change in entries {
+            self.apply(change)
                 .expect("a change that succeeded succeeds again from the same state");
         }
         *self.journal() = journal;
