@@ -147,13 +147,13 @@ impl<const N: usize> Solver<N> {
         }
     }
 
-    /// True while Radau IIA steps.
     /// The error weights, which a caller may change between calls (a component weighted 0 by
     /// an infinite atol: examples/free_flight_bound.rs).
     pub fn tolerance_mut(&mut self) -> &mut Tolerance<N> {
         &mut self.tol
     }
 
+    /// True while Radau IIA steps.
     pub fn is_implicit(&self) -> bool {
         self.rk.mode == Mode::Radau
     }

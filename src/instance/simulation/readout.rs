@@ -83,7 +83,11 @@ impl<'a> Readout<'a> {
     fn shaft(&self) -> &Shaft {
         self.shaft.get_or_init(|| match self.interface {
             Interface::CoSimulation => self.sim.shaft(),
-            Interface::ModelExchange => self.point().0,
+            Interface::ModelExchange => {
+                let (shaft, loads) = self.point();
+                let _ = self.loads.set(loads);
+                shaft
+            }
         })
     }
 
@@ -91,11 +95,16 @@ impl<'a> Readout<'a> {
     fn loads(&self) -> &Loads {
         self.loads.get_or_init(|| match self.interface {
             Interface::CoSimulation => self.now().loads(self.shaft()),
-            Interface::ModelExchange => self.point().1,
+            Interface::ModelExchange => {
+                let (shaft, loads) = self.point();
+                let _ = self.shaft.set(shaft);
+                loads
+            }
         })
     }
 
-    /// Model Exchange's point: the shaft's motion and the loads in the region ξ is in.
+    /// Model Exchange's point: the shaft's motion and the loads in the region ξ is in, both
+    /// kept by whichever of [`shaft`](Self::shaft) and [`loads`](Self::loads) asks first.
     fn point(&self) -> (Shaft, Loads) {
         let point = self.sim.point();
         (point.shaft, point.loads)
