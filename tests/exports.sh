@@ -10,7 +10,7 @@ expected_exports() {
     cat "${lists[@]}" | grep -v '^#' | tr -s ' \n' '\n\n' | sed '/^$/d' | sort
 }
 
-# $1: the model; prints the prefixes of its exports, for the messages.
+# $1: the model; names what it exports, for the messages.
 export_prefixes() {
-    if [[ " $FMI3_MODELS " == *" $1 "* ]]; then echo "fmi2* and fmi3*"; else echo "fmi2*"; fi
+    if [[ " $FMI3_MODELS " == *" $1 "* ]]; then echo "fmi2*, fmi3* and gearRattleDoStepSampled"; else echo "fmi2* and gearRattleDoStepSampled"; fi
 }
