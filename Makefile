@@ -29,14 +29,23 @@ PACKAGE := cargo run --profile quick --quiet -p packaging --bin package --
 # Fragments in mk/ (one per capability: windows, benchmarks, rattle map) add to these;
 # FMU_PLATFORMS: the platforms of the FMUs' binaries as PLATFORM:EXTENSION (linux64:so...).
 FMU_PLATFORMS :=
-TEST_TARGETS := test-rust test-python
+# pytest runs in two parts, so that make test's -j2 keeps both cores busy to its end: the FMUs'
+# own suites (every testpath of pytest.ini but the two below), and the studies' and the
+# masters' (docs/DEVELOPING.md). `make test-python` runs both.
+PYTEST_LAST := tests/study tests/masters
+PYTEST_PARTS := test-python-fmus test-python-tools
+TEST_TARGETS := test-rust
 
-.PHONY: all fmu demo test test-rust test-python setup clean
+.PHONY: all fmu demo test test-rust test-python $(PYTEST_PARTS) setup clean
 
 all: fmu
 
 # Included before the rules so that the fragments' prerequisites are seen.
 include $(wildcard mk/*.mk)
+# The parts start longest first (in a fresh clone about 180, 140 and 70 s: the FMUs' pytest, the
+# fuzzer's build and run, the studies' pytest), the short ones after them.
+LONGEST_PARTS := test-python-fmus fuzz test-python-tools
+TEST_TARGETS := $(LONGEST_PARTS) $(filter-out $(LONGEST_PARTS),$(TEST_TARGETS))
 
 ## fmu: build target/fmu/GearRattle.fmu and GearboxRattle.fmu (FMI 2.0) and the same in target/fmu/fmi3/ (FMI 3.0), linux64, darwin64, win64
 fmu: $(foreach m,$(MODELS),target/fmu/$(m).fmu) $(foreach m,$(FMU3_MODELS),target/fmu/fmi3/$(m).fmu)
@@ -109,8 +118,12 @@ CAPI_LIB = $(call linux_so,$(crate_GearRattle))
 test-rust: $(CAPI_LIB) | libclang
 	GEAR_RATTLE_CDYLIB=$(abspath $(CAPI_LIB)) $(CARGO_TEST) -p gear_rattle -p gearbox_rattle -p fmi2-shell -p fmi3-shell
 
-test-python: fmu $(VENV)/.installed
-	$(PY) -m pytest -q
+test-python: $(PYTEST_PARTS)
+$(PYTEST_PARTS): fmu $(VENV)/.installed
+test-python-fmus:
+	$(PY) -m pytest -q $(addprefix --ignore=,$(PYTEST_LAST))
+test-python-tools:
+	$(PY) -m pytest -q $(PYTEST_LAST)
 
 setup: libclang $(VENV)/.installed
 

@@ -9,7 +9,7 @@
 
 # tests/gearbox is in pytest's testpaths: `make test-python` runs it on this FMU (and on the
 # Flywheel partner's, coupled by libcosim and Ecos).
-test-python: $(GEARBOX_FMU)
+$(PYTEST_PARTS): $(GEARBOX_FMU)
 
 ## bench-gearbox: the gearbox's cost against its gears one by one, scipy at equal error, a map, n_gears
 bench-gearbox: fmu $(VENV)/.installed

@@ -23,7 +23,7 @@ $(FLYWHEEL_FMU): FORCE
 
 # The master tests live in pytest's testpaths: `make test-python` runs them, so it needs
 # the partner FMU and the Ecos runtime library too.
-test-python: $(FLYWHEEL_FMU) | libtbb
+$(PYTEST_PARTS): $(FLYWHEEL_FMU) | libtbb
 
 ## test-flywheel: the partner's own Rust tests (cargo test -p flywheel)
 test-flywheel:
