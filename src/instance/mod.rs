@@ -15,7 +15,7 @@ use crate::integrator::SolverError;
 use crate::physics::Shaft;
 use crate::rattle::Impacts;
 use fmi2_shell::values::Values;
-use fmi2_shell::{Continuous, Core, EventInfo, Identity, Interface, Model, Slave, Stepping};
+use fmi2_shell::{Continuous, Core, EventInfo, Grid, Identity, Interface, Model, Slave, Stepping};
 
 use serde::{Deserialize, Serialize};
 
@@ -178,6 +178,17 @@ impl Stepping for Instance {
         let sim = self.core.running_mut();
         sim.t = current;
         sim.step_until(t_end, at_event)
+    }
+
+    /// Served where every variable read is F_contact (the sound's read: docs/SOUND.md, "The
+    /// force"); any other is read the ordinary way.
+    fn serve(&mut self, grid: &Grid, vrs: &[u32], out: &mut [f64]) -> usize {
+        match &mut self.core.sim {
+            Some(sim) if vrs.iter().all(|vr| *vr == vr::F_contact) => {
+                sim.serve_forces(grid.ends(), vrs.len(), out)
+            }
+            _ => 0,
+        }
     }
 
     fn is_finite(&self) -> bool {
