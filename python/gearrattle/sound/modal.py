@@ -75,10 +75,10 @@ def foh_recursion(mode, h, decimate=1):
     return e ** D, c, r, s1
 
 
-# Rows of the force's windows multiplied at once (_inputs): a product this small runs on one
-# thread of the BLAS; a larger one wakes its threads, whose spinning after it costs several
-# times the product's CPU.
-BLOCK = 4096
+# Multiply-adds of one matrix product in _inputs: a product this small runs on one thread of
+# the BLAS (OpenBLAS shares out those above 2^18); a shared one leaves its threads spinning
+# after it, CPU that costs several times the product's and lands on whatever runs next.
+PRODUCT = 1 << 17
 
 
 def _inputs(recursions, force, D):
@@ -86,7 +86,8 @@ def _inputs(recursions, force, D):
     m = 0 .. M − 1, u[m] = sum_j c[j] F[m D + j] (j = 0 .. D, M = (len(F) − 1) // D), as the
     columns of one matrix product: the force's windows of D + 1 samples, a view of it with
     rows D samples apart, times the real coefficients Re(r c[j]) and Re(r conj(lam) c[j]), in
-    blocks of BLOCK rows. Returns (M, 2 K) for K modes, the first K columns the former."""
+    blocks of rows of PRODUCT multiply-adds. Returns (M, 2 K) for K modes, the first K columns
+    the former."""
     M = (len(force) - 1) // D
     step = force.strides[0]
     windows = np.lib.stride_tricks.as_strided(force, (M, D + 1), (D * step, step),
@@ -94,8 +95,9 @@ def _inputs(recursions, force, D):
     coefficients = np.array([(r * c).real for lam, c, r, _ in recursions]
                             + [(r * np.conj(lam) * c).real for lam, c, r, _ in recursions]).T
     u = np.empty((M, coefficients.shape[1]))
-    for i in range(0, M, BLOCK):
-        np.matmul(windows[i:i + BLOCK], coefficients, out=u[i:i + BLOCK])
+    rows = max(1, PRODUCT // coefficients.size)
+    for i in range(0, M, rows):
+        np.matmul(windows[i:i + rows], coefficients, out=u[i:i + rows])
     return u
 
 
