@@ -12,7 +12,7 @@ use crate::slave::Slave;
 use crate::slave::{Interface, Lifecycle};
 use crate::state::FmiState;
 use crate::status::FmiResult;
-use crate::stepping::Stepping;
+use crate::stepping::{Grid, Stepping};
 use crate::values::Values;
 use crate::vectors::Continuous;
 use serde::de::DeserializeOwned;
@@ -147,5 +147,9 @@ impl<M: Model> Lifecycle for M {
 
     fn step_to_event(&mut self, current: f64, t_end: f64) -> FmiResult<f64> {
         self.step_until(current, t_end, true)
+    }
+
+    fn sample(&mut self, grid: &Grid, vrs: &[u32], out: &mut [f64]) -> usize {
+        self.serve_sampled(grid, vrs, out)
     }
 }

@@ -60,5 +60,5 @@ pub use log::{Log, Message};
 pub use slave::{EventInfo, Identity, Interface, Lifecycle, Slave};
 pub use state::FmiState;
 pub use status::{FmiError, FmiResult, Status};
-pub use stepping::Stepping;
+pub use stepping::{Grid, Stepping};
 pub use vectors::Continuous;

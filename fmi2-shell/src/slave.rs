@@ -8,6 +8,7 @@ use crate::contract::{Kind, Variable, no_variables};
 use crate::log::{Categories, Log};
 use crate::state::FmiState;
 use crate::status::{FmiError, FmiResult};
+use crate::stepping::Grid;
 use crate::vectors::{Continuous, NoContinuous};
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
@@ -101,6 +102,16 @@ pub trait Lifecycle: Sized {
     /// STEPS_TO_EVENTS.
     fn step_to_event(&mut self, t: f64, t_end: f64) -> FmiResult<f64> {
         self.step(t, t_end - t).map(|()| t_end)
+    }
+
+    /// The first steps of the sampling entry's `grid` that the model takes without stepping,
+    /// the Real variables `vrs` read after each into `out` (rows of vrs.len() values), each
+    /// to the bit as [`step`](Lifecycle::step) and fmi2GetReal: how many (see
+    /// [`Stepping::serve`]). None by default: each step is taken the ordinary way.
+    ///
+    /// [`Stepping::serve`]: crate::stepping::Stepping::serve
+    fn sample(&mut self, _grid: &Grid, _vrs: &[u32], _out: &mut [f64]) -> usize {
+        0
     }
 }
 

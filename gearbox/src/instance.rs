@@ -9,8 +9,8 @@ use crate::contract::{self, Causality, Kind, LOG_CATEGORIES, VARIABLES, vr};
 use crate::outputs::Now;
 use crate::simulation::{self, Simulation};
 use fmi2_shell::{
-    Continuous, Core, EventInfo, FmiError, FmiResult, FmiState, Identity, Interface, Model, Slave,
-    Status, Stepping,
+    Continuous, Core, EventInfo, FmiError, FmiResult, FmiState, Grid, Identity, Interface, Model,
+    Slave, Status, Stepping,
 };
 use gear_rattle::instance::Journaled;
 use gear_rattle::integrator::SolverError;
@@ -120,6 +120,19 @@ impl Stepping for Instance {
         let sim = self.core.running_mut();
         sim.t = current;
         sim.step_until(t_end, at_event)
+    }
+
+    /// Served where every variable read is a gear's contact force (the sound's reads:
+    /// docs/SOUND.md, "The force"); any other is read the ordinary way.
+    fn serve(&mut self, grid: &Grid, vrs: &[u32], out: &mut [f64]) -> usize {
+        let Some(sim) = self.core.sim.as_mut() else {
+            return 0;
+        };
+        let gears: Option<Vec<usize>> = vrs.iter().map(|vr| sim.contact_force_gear(*vr)).collect();
+        match gears {
+            Some(gears) => sim.serve_forces(grid.ends(), &gears, out),
+            None => 0,
+        }
     }
 
     fn is_finite(&self) -> bool {
@@ -304,5 +317,55 @@ impl Slave for Instance {
             }
             None => Ok(()),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::outputs::tests::{contact_forces, on_engine};
+
+    /// The sound's grid through the sampling entry (steps served from the solver's kept steps
+    /// where it can) against fmi2DoStep and fmi2GetReal at every point: the same forces and
+    /// the same simulation, to the bit, through the start-up's impacts and the statistics
+    /// window's opening, over more changes than the journal records. The journal replays the
+    /// served runs to the same state (what a failed step puts back).
+    #[test]
+    fn sampled_steps_are_the_ordinary_ones() {
+        std::thread::Builder::new()
+            .stack_size(8 << 20)
+            .spawn(|| {
+                let start = || on_engine(&[(vr::stats_from, 0.013)]);
+                let forces = contact_forces();
+                let (h, n, m) = (1.0 / 192_000.0, 1920, forces.len());
+                let (mut sampled, mut plain) = (start(), start());
+                let (mut out, mut row) = (vec![0.0; n * m], vec![0.0; m]);
+                let mut in_contact = 0;
+                for call in 0..12 {
+                    let t0 = (call * n) as f64 * h;
+                    sampled
+                        .do_step_sampled(t0, h, n, &forces, &mut out)
+                        .unwrap();
+                    for (k, want) in out.chunks(m).enumerate() {
+                        plain.do_step(t0 + k as f64 * h, h).unwrap();
+                        plain.slave.get_real(&forces, &mut row).unwrap();
+                        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                        assert_eq!(bits(want), bits(&row), "call {call}, point {k}");
+                        in_contact += row.iter().filter(|f| **f != 0.0).count();
+                    }
+                    assert!(sampled.slave.simulation() == plain.slave.simulation());
+                }
+                assert!(in_contact > 100, "{in_contact} samples in contact");
+                let sim = sampled.slave.core.running_mut();
+                assert!(matches!(sim.run, simulation::Run::Windowed(_)));
+                // What a failed step does: back to the journal's copy, then its changes.
+                let before = sim.clone();
+                sim.replay();
+                assert!(*sim == before);
+                assert_eq!(sim.stats(), before.stats());
+            })
+            .unwrap()
+            .join()
+            .unwrap();
     }
 }

@@ -125,6 +125,19 @@ impl Now<'_> {
     }
 }
 
+/// Gear i's contact force at its ξ_i and ξ_i', read from the gearbox's state through
+/// `state` (a component by its index), in the region the gear is in; 0 beyond n_gears.
+pub fn mesh_force(gearbox: &Gearbox, i: usize, state: impl Fn(usize) -> f64) -> f64 {
+    match gearbox.gears[..gearbox.n_gears()].get(i) {
+        Some(g) => g
+            .dynamics
+            .law
+            .force(g.region, state(xi(i)), state(xi_dot(i)))
+            .total(),
+        None => 0.0,
+    }
+}
+
 impl Simulation {
     /// The value of a Real output or local, computed now; None if `vr` is none.
     pub fn real_output(&self, vr: u32) -> Option<f64> {
@@ -136,19 +149,16 @@ impl Simulation {
     /// the sound reads at every sample (docs/SOUND.md, "The force"). None for any other
     /// variable, and in Model Exchange, where the outputs read the settled regions.
     pub fn contact_force(&self, vr: u32) -> Option<f64> {
-        let (i, offset) = vr::gear::locate(vr)?;
-        if offset != offset::F_contact || self.model_exchange {
-            return None;
-        }
+        let i = self.contact_force_gear(vr)?;
         let (gearbox, y) = self.gearbox();
-        Some(match gearbox.gears[..gearbox.n_gears()].get(i) {
-            Some(g) => g
-                .dynamics
-                .law
-                .force(g.region, y[xi(i)], y[xi_dot(i)])
-                .total(),
-            None => 0.0,
-        })
+        Some(mesh_force(gearbox, i, |k| y[k]))
+    }
+
+    /// The gear whose F_contact `vr` is, as [`contact_force`](Self::contact_force) reads it;
+    /// None for any other variable, and in Model Exchange.
+    pub fn contact_force_gear(&self, vr: u32) -> Option<usize> {
+        let (i, offset) = vr::gear::locate(vr)?;
+        (offset == offset::F_contact && !self.model_exchange).then_some(i)
     }
 
     /// The Model Exchange variables that are not outputs: the state x_omega_I and the
@@ -290,11 +300,33 @@ fn stat_integer(m: Option<&Metrics>, offset: u32) -> Option<i64> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use crate::contract::{Kind, vr};
     use crate::instance::Instance;
     use crate::outputs::Now;
     use fmi2_shell::{Fmu, Interface};
+
+    /// A co-simulation instance on the built-in engine (excitation 1), initialised with the
+    /// Real parameters `reals` set.
+    pub(crate) fn on_engine(reals: &[(u32, f64)]) -> Fmu<Instance> {
+        let mut fmu = Fmu::<Instance>::new(false, Interface::CoSimulation);
+        fmu.set_integer(&[vr::excitation], &[1]).unwrap();
+        for (vr, value) in reals {
+            fmu.set_real(&[*vr], &[*value]).unwrap();
+        }
+        fmu.enter_initialization_mode().unwrap();
+        fmu.exit_initialization_mode().unwrap();
+        fmu
+    }
+
+    /// Every gear slot's F_contact.
+    pub(crate) fn contact_forces() -> Vec<u32> {
+        crate::contract::VARIABLES
+            .iter()
+            .filter(|v| v.kind == Kind::Real && v.name.ends_with(".F_contact"))
+            .map(|v| v.vr)
+            .collect()
+    }
 
     /// The contact force read alone is the readout's, to the bit, for every gear slot at
     /// every point of a fine grid through the start-up's impacts (none in Model Exchange,
@@ -304,15 +336,8 @@ mod tests {
         std::thread::Builder::new()
             .stack_size(8 << 20)
             .spawn(|| {
-                let mut fmu = Fmu::<Instance>::new(false, Interface::CoSimulation);
-                fmu.set_integer(&[vr::excitation], &[1]).unwrap();
-                fmu.enter_initialization_mode().unwrap();
-                fmu.exit_initialization_mode().unwrap();
-                let forces: Vec<u32> = crate::contract::VARIABLES
-                    .iter()
-                    .filter(|v| v.kind == Kind::Real && v.name.ends_with(".F_contact"))
-                    .map(|v| v.vr)
-                    .collect();
+                let mut fmu = on_engine(&[]);
+                let forces = contact_forces();
                 assert_eq!(forces.len(), gear_rattle::gearbox::MAX_GEARS);
                 let (h, mut in_contact) = (1.0 / 192_000.0, 0);
                 for k in 0..3840 {

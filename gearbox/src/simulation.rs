@@ -7,12 +7,14 @@ use serde::{Deserialize, Serialize};
 
 use crate::contract::{self, vr};
 use crate::independent::Independent;
+use crate::outputs::mesh_force;
 use crate::windowed::{self, Windowed};
 use fmi2_shell::values::Values;
 use fmi2_shell::{FmiError, FmiResult};
 use gear_rattle::gearbox::{self, Drive, Gearbox, GearboxParams, LooseGear, PHI, State, xi};
 use gear_rattle::instance::simulation::journal::{Change, Journal, Journaled};
 use gear_rattle::instance::simulation::{Stepped, method};
+use gear_rattle::integrator::solver::Point;
 use gear_rattle::integrator::{Method, Solver, SolverError, Stats};
 use gear_rattle::physics::{
     DamperParams, Engine, EngineOrder, EngineParams, GearParams, Oil, Polynomial, Shaft,
@@ -339,6 +341,44 @@ impl Simulation {
         }
     }
 
+    /// The calls of `step_until` (not stopping at impacts) from each `from` to its `to` in
+    /// `calls`, each continuing where the one before ends, as far as the solver serves them
+    /// without stepping ([`Solver::serve_run`]), the contact force of each of `gears` (see
+    /// [`mesh_force`]) read at each end into a row of `out`: how many were taken. A force
+    /// that is not finite is left to the ordinary read, which refuses it. None on gears
+    /// stepped apart, nor across the statistics window's opening.
+    pub fn serve_forces(
+        &mut self,
+        calls: impl Iterator<Item = (f64, f64)>,
+        gears: &[usize],
+        out: &mut [f64],
+    ) -> usize {
+        let mut calls = calls.peekable();
+        let Some(&(from, _)) = calls.peek() else {
+            return 0;
+        };
+        let m = gears.len();
+        let mut rows = out.chunks_exact_mut(m.max(1));
+        let window_from = self.window_from;
+        self.served(from, |sim| match &mut sim.run {
+            Run::Lean(k) => {
+                let shut = |&(_, to): &(f64, f64)| window::opening(window_from, from, to).is_none();
+                let calls = calls.take_while(shut);
+                k.solver
+                    .serve_run(&k.system, &mut sim.t, &mut k.y, calls, |g, at| {
+                        read_forces(g, &at, gears, rows.next())
+                    })
+            }
+            Run::Windowed(k) => {
+                k.solver
+                    .serve_run(&k.system, &mut sim.t, &mut k.y, calls, |w, at| {
+                        read_forces(&w.inner, &at, gears, rows.next())
+                    })
+            }
+            Run::Independent(_) => 0,
+        })
+    }
+
     pub fn stats(&self) -> Stats {
         on_run!(&self.run, k => k.solver.stats, p => p.stats())
     }
@@ -350,6 +390,23 @@ impl Simulation {
     pub fn proposed_step(&self) -> f64 {
         on_run!(&self.run, k => k.solver.proposed_step(), p => p.proposed_step())
     }
+}
+
+/// The contact force of each of `gears` at the point `at` into `row` (none to read: no row);
+/// false where one is not finite.
+fn read_forces<const N: usize>(
+    gearbox: &Gearbox,
+    at: &Point<N>,
+    gears: &[usize],
+    row: Option<&mut [f64]>,
+) -> bool {
+    let Some(row) = row else {
+        return gears.is_empty();
+    };
+    for (value, &i) in row.iter_mut().zip(gears) {
+        *value = mesh_force(gearbox, i, |k| at.component(k));
+    }
+    row.iter().all(|v| v.is_finite())
 }
 
 /// The gearbox's changes in co-simulation: steps and new inputs.

@@ -101,6 +101,38 @@ impl<S: GearPair<N> + Jacobian<N> + Copy, const N: usize> Stepped<S, N> {
         self.advance_until(t, t_end, impacts)
     }
 
+    /// The calls of `advance` (not stopping at impacts) from each `from` to its `to` in
+    /// `calls`, the first from `from`, as far as the solver serves them without stepping
+    /// ([`Solver::serve_run`]), the contact force read `reads` times at each end into a row
+    /// of `out`: how many were taken. A force that is not finite is left to the ordinary
+    /// read, which refuses it. None across the statistics window's opening.
+    fn serve_forces(
+        &mut self,
+        t: &mut f64,
+        from: f64,
+        calls: impl Iterator<Item = (f64, f64)>,
+        reads: usize,
+        out: &mut [f64],
+    ) -> usize {
+        let w = self.system.window();
+        let (opened, opens) = (w.is_opened(), w.from);
+        let shut = |&(_, to): &(f64, f64)| opened || window::opening(opens, from, to).is_none();
+        let mut rows = out.chunks_exact_mut(reads.max(1));
+        let calls = calls.take_while(shut);
+        self.solver
+            .serve_run(&self.system, t, &mut self.y, calls, |pair, at| {
+                let (xi, xi_dot) = (at.component(S::XI), at.component(S::XI_DOT));
+                let force = pair.dynamics().law.force(pair.region(), xi, xi_dot).total();
+                match rows.next() {
+                    Some(row) => {
+                        row.fill(force);
+                        force.is_finite()
+                    }
+                    None => reads == 0,
+                }
+            })
+    }
+
     /// The pair at t0 with the state's first components `head` (the quadratures from 0) and
     /// its statistics window opening at `window`, if any: a window that opens at t0 keeps
     /// the initial quadratures.
@@ -467,6 +499,26 @@ impl Simulation {
     /// Advances to t_end. On failure the simulation is left as it was.
     pub fn step_to(&mut self, t_end: f64) -> Result<(), SolverError> {
         self.step_until(t_end, false).map(|_| ())
+    }
+
+    /// The calls of `step_until` (not stopping at impacts) from each `from` to its `to` in
+    /// `calls`, each continuing where the one before ends, as far as the solver serves them
+    /// without stepping, F_contact read `reads` times at each end into a row of `out`: how
+    /// many were taken. Only on the bench's sine: the other drives' inputs follow each step.
+    pub fn serve_forces(
+        &mut self,
+        calls: impl Iterator<Item = (f64, f64)>,
+        reads: usize,
+        out: &mut [f64],
+    ) -> usize {
+        let mut calls = calls.peekable();
+        let (Drive::Sine(_), Some(&(from, _))) = (self.drive, calls.peek()) else {
+            return 0;
+        };
+        self.served(
+            from,
+            |sim| on_gear!(&mut sim.gear, k => k.serve_forces(&mut sim.t, from, calls, reads, out)),
+        )
     }
 
     /// The value of a Real output read in co-simulation, computed now; None if `vr` is not a

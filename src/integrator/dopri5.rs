@@ -213,6 +213,21 @@ impl<const N: usize> Continuous<N> {
     pub fn at(&self, theta: f64) -> [f64; N] {
         std::array::from_fn(|i| hairer(&self.rows[i], theta))
     }
+
+    /// Component i of [`at`](Self::at), to the bit.
+    #[inline]
+    pub fn component(&self, i: usize, theta: f64) -> f64 {
+        hairer(&self.rows[i], theta)
+    }
+
+    /// Whether every component stays below `bound` in magnitude for θ ∈ [0, 1], each of
+    /// Hairer's partial sums too: the sum of its coefficients' magnitudes does (θ and 1 − θ
+    /// are at most 1).
+    pub fn bounded(&self, bound: f64) -> bool {
+        self.rows
+            .iter()
+            .all(|c| c.iter().map(|c| c.abs()).sum::<f64>() < bound)
+    }
 }
 
 impl<const N: usize> Dense<N> for Trial<N> {

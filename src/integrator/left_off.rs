@@ -20,6 +20,13 @@ impl<const N: usize> LeftOff<N> {
     /// differently (a master passing k·h where t_end was (k−1)·h + h): a few ulps are the
     /// same point; the state must be the same bits.
     pub fn continued_by(&self, t: f64, y: &[f64; N]) -> bool {
-        (t - self.t).abs() <= 4.0 * f64::EPSILON * self.t.abs() && *y == self.y
+        same_time(self.t, t) && *y == self.y
     }
+}
+
+/// Whether a call from t continues one that left off at `left`, as far as time goes (see
+/// [`LeftOff::continued_by`]).
+#[inline]
+pub(super) fn same_time(left: f64, t: f64) -> bool {
+    (t - left).abs() <= 4.0 * f64::EPSILON * left.abs()
 }

@@ -15,12 +15,12 @@ use super::control::Tolerance;
 use super::dopri5;
 use super::edges::locate_crossing;
 use super::entries::Entry;
-use super::left_off::LeftOff;
+use super::left_off::{LeftOff, same_time};
 use super::passage::{self, Passage};
 use super::radau5::Jacobian;
 use super::runge_kutta::{Accepted, Mode, RungeKutta};
 use super::work::Call;
-use super::{Crossing, Piecewise, taylor};
+use super::{Crossing, Dense, Piecewise, taylor};
 use serde::{Deserialize, Serialize};
 
 pub use super::runge_kutta::Method;
@@ -109,6 +109,40 @@ impl<const N: usize> Interpolant<N> {
             Interpolant::Taylor(s) => s.at(theta),
         }
     }
+
+    /// Component i of [`at`](Self::at), to the bit.
+    #[inline]
+    fn component(&self, i: usize, theta: f64) -> f64 {
+        match self {
+            Interpolant::Dopri5(c) => c.component(i, theta),
+            Interpolant::Taylor(s) => s.dense(i, theta),
+        }
+    }
+
+    /// Whether every component stays finite throughout the step (with a margin for the
+    /// rounding of θ at its ends).
+    fn finite_throughout(&self) -> bool {
+        let bound = f64::MAX / 4.0;
+        match self {
+            Interpolant::Dopri5(c) => c.bounded(bound),
+            Interpolant::Taylor(s) => s.bounded(bound),
+        }
+    }
+}
+
+/// The state at the end of a call served by [`Solver::serve_run`], read component by
+/// component from the kept step's dense output: only the components read are computed.
+pub struct Point<'a, const N: usize> {
+    dense: &'a Interpolant<N>,
+    theta: f64,
+}
+
+impl<const N: usize> Point<'_, N> {
+    /// Component i of the state there, to the bit as a call of `advance` ending there has it.
+    #[inline]
+    pub fn component(&self, i: usize) -> f64 {
+        self.dense.component(i, self.theta)
+    }
 }
 
 /// The driver over a piecewise system's pieces, with edge location; all of its state is
@@ -196,6 +230,54 @@ impl<const N: usize> Solver<N> {
         (*t, *y) = (t_end, y_end);
         self.stats.exact_evals += evals;
         true
+    }
+
+    /// The calls of `advance` from each `from` to its `to` in `calls` (each continuing where
+    /// the one before ends), as far as the step kept by the last call reaches: each served
+    /// from its dense output, to the bit as `advance` would, with no stepping or search, so
+    /// none can fail and the counters do not move. `read` reads the state at the end of each
+    /// (through [`Point::component`]) and says whether to take it; the first call not
+    /// served, or not taken, ends the run. Returns how many were taken, (t, y) at the end of
+    /// the last one as `advance` leaves them. None where no step is kept (a passage in
+    /// closed form serves its end times the ordinary way), or where its dense output might
+    /// not stay finite (the ordinary call then finds out).
+    pub fn serve_run<S>(
+        &mut self,
+        sys: &S,
+        t: &mut f64,
+        y: &mut [f64; N],
+        calls: impl Iterator<Item = (f64, f64)>,
+        mut read: impl FnMut(&S, Point<N>) -> bool,
+    ) -> usize {
+        let Some(Kept::Step(a)) = &mut self.kept else {
+            return 0;
+        };
+        // Where the last call taken ends.
+        let (mut left, mut taken) = (None, 0);
+        for (from, to) in calls {
+            let continued = match left {
+                None => a.left_off.continued_by(from, y) && a.dense.finite_throughout(),
+                Some(left) => same_time(left, from),
+            };
+            if !(continued && to <= a.t1()) {
+                break;
+            }
+            let theta = (to - a.t0) / a.h;
+            if !read(
+                sys,
+                Point {
+                    dense: &a.dense,
+                    theta,
+                },
+            ) {
+                break;
+            }
+            (left, taken) = (Some(to), taken + 1);
+        }
+        if let Some(left) = left {
+            (*t, *y) = (left, a.serve(left));
+        }
+        taken
     }
 
     /// Advances (t, y) to `t_end` exactly.

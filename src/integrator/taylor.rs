@@ -65,6 +65,13 @@ impl<const N: usize> Step<N> {
         self.y1 = self.at(1.0);
     }
 
+    /// Whether every component stays below `bound` in magnitude for θ ∈ [0, 1], each of
+    /// Horner's partial sums too: Σ_k |c_k| |h|^k does.
+    pub fn bounded(&self, bound: f64) -> bool {
+        let h = self.h.abs();
+        (0..N).all(|i| self.c.iter().rev().fold(0.0, |acc, c| acc * h + c[i].abs()) < bound)
+    }
+
     /// The same series cut to end at θ ∈ [0, 1] of the step.
     pub fn cut(&self, theta: f64) -> Self {
         Step::new(self.c, theta * self.h)

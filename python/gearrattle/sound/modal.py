@@ -75,22 +75,44 @@ def foh_recursion(mode, h, decimate=1):
     return e ** D, c, r, s1
 
 
-def _real_part(recursion, shifted, F0):
-    """Re(r x[m]) for m = 0 .. M of a mode's recursion (lam, c, r, s1) driven by the shifted
-    force samples, x[0] = −F0/s1 (the state under the constant force F0), as one real
-    second-order recursion: Re(r x) has the poles lam and conj(lam), so it is
-    A(z) = 1 − 2 Re(lam) z⁻¹ + |lam|² z⁻² applied to Re(r (1 − conj(lam) z⁻¹) u), u the
-    complex input sum_j c[j] F[m D + j], plus the free response of x[0] (as initial
+# Multiply-adds of one matrix product in _inputs: a product this small runs on one thread of
+# the BLAS (OpenBLAS shares out those above 2^18); a shared one leaves its threads spinning
+# after it, CPU that costs several times the product's and lands on whatever runs next.
+PRODUCT = 1 << 17
+
+
+def _inputs(recursions, force, D):
+    """For each mode's recursion (lam, c, r, s1), Re(r u[m]) and Re(r conj(lam) u[m]) for
+    m = 0 .. M − 1, u[m] = sum_j c[j] F[m D + j] (j = 0 .. D, M = (len(F) − 1) // D), as the
+    columns of one matrix product: the force's windows of D + 1 samples, a view of it with
+    rows D samples apart, times the real coefficients Re(r c[j]) and Re(r conj(lam) c[j]), in
+    blocks of rows of PRODUCT multiply-adds. Returns (M, 2 K) for K modes, the first K columns
+    the former."""
+    M = (len(force) - 1) // D
+    step = force.strides[0]
+    windows = np.lib.stride_tricks.as_strided(force, (M, D + 1), (D * step, step),
+                                              writeable=False)
+    coefficients = np.array([(r * c).real for lam, c, r, _ in recursions]
+                            + [(r * np.conj(lam) * c).real for lam, c, r, _ in recursions]).T
+    u = np.empty((M, coefficients.shape[1]))
+    rows = max(1, PRODUCT // coefficients.size)
+    for i in range(0, M, rows):
+        np.matmul(windows[i:i + rows], coefficients, out=u[i:i + rows])
+    return u
+
+
+def _real_part(recursion, forced, delayed, F0):
+    """Re(r x[m]) for m = 0 .. M of a mode's recursion (lam, c, r, s1) driven by the force,
+    x[0] = −F0/s1 (the state under the constant force F0), as one real second-order
+    recursion: Re(r x) has the poles lam and conj(lam), so it is
+    A(z) = 1 − 2 Re(lam) z⁻¹ + |lam|² z⁻² applied to Re(r (1 − conj(lam) z⁻¹) u), u[m] the
+    complex input sum_j c[j] F[m D + j] entering at m + 1 (`forced` its Re(r u), `delayed`
+    its Re(r conj(lam) u), from _inputs), plus the free response of x[0] (as initial
     conditions)."""
-    lam, c, r, s1 = recursion
-    u_re = np.zeros(len(shifted[0]) + 1)
-    u_im = np.zeros(len(shifted[0]) + 1)
-    for cj, fj in zip(c, shifted):
-        u_re[1:] += cj.real * fj
-        u_im[1:] += cj.imag * fj
-    rl = r * np.conj(lam)
-    v = r.real * u_re - r.imag * u_im
-    v[1:] -= rl.real * u_re[:-1] - rl.imag * u_im[:-1]
+    lam, _, r, s1 = recursion
+    v = np.zeros(len(forced) + 1)
+    v[1:] = forced
+    v[2:] -= delayed[:-1]
     a = [1.0, -2 * lam.real, abs(lam) ** 2]
     w = r * (-F0 / s1)  # Re(w lam^m), m = -1, -2: the free response before the start
     return lfilter([1.0], a, v, zi=lfiltic([1.0], a, [(w / lam).real, (w / lam ** 2).real]))[0]
@@ -119,14 +141,14 @@ class ModalTransfer:
         intervals: one recursion over the kept samples instead of D."""
         force = np.asarray(force, dtype=float)
         D = decimate
-        M = (len(force) - 1) // D  # intervals of D samples
-        p = np.zeros(M + 1)
-        # F[m D + j] for m = 0 .. M − 1, one array for each j = 0 .. D
-        shifted = [force[j:j + M * D:D] for j in range(D + 1)]
-        for m in self.modes:
-            g = m.gain(mesh)
-            if g:
-                p += 2 * g * _real_part(foh_recursion(m, h, D), shifted, force[0])
+        p = np.zeros((len(force) - 1) // D + 1)  # one more than the intervals of D samples
+        heard = [(m.gain(mesh), foh_recursion(m, h, D)) for m in self.modes if m.gain(mesh)]
+        if not heard:
+            return p
+        u = _inputs([rec for _, rec in heard], force, D)
+        K = len(heard)
+        for k, (g, rec) in enumerate(heard):
+            p += 2 * g * _real_part(rec, u[:, k], u[:, K + k], force[0])
         return p
 
     def render(self, force, mesh, subsample):

@@ -145,6 +145,33 @@ pub trait Journaled<const ENTRIES: usize> {
             .expect("a change of inputs does not step");
     }
 
+    /// Calls of [`step_until`](Self::step_until) without `at_impact`, the first from `from`,
+    /// each continuing where the one before ends, that `serve` takes without stepping (the
+    /// solver serving their ends from its kept step: [`Solver::serve_run`]) and counts.
+    /// Recorded as one step from `from` to the time they reach, which, replayed, the solver
+    /// serves from the same kept step to the same state (serving moves no counter).
+    ///
+    /// [`Solver::serve_run`]: crate::integrator::Solver::serve_run
+    fn served(&mut self, from: f64, serve: impl FnOnce(&mut Self) -> usize) -> usize
+    where
+        Self: Sized,
+    {
+        if self.journal().is_due() {
+            let copy = self.copy();
+            self.journal().start(copy);
+        }
+        let taken = serve(self);
+        if taken > 0 {
+            let to = *self.time();
+            self.journal().record(Change::Step {
+                from,
+                to,
+                at_impact: false,
+            });
+        }
+        taken
+    }
+
     /// Makes the change without the journal; returns the time reached.
     fn apply(&mut self, change: Change<Self::Input>) -> Result<f64, SolverError> {
         match change {
