@@ -121,7 +121,7 @@ test-rust: $(CAPI_LIB) | libclang
 test-python: $(PYTEST_PARTS)
 $(PYTEST_PARTS): fmu $(VENV)/.installed
 test-python-fmus:
-	$(PY) -m pytest -q $(addprefix --ignore=,$(PYTEST_LAST))
+	$(PY) -m pytest -q $(foreach d,$(PYTEST_LAST),--ignore-glob='$(d)/*')
 test-python-tools:
 	$(PY) -m pytest -q $(PYTEST_LAST)
 
