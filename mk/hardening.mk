@@ -5,7 +5,7 @@
 #   make check-memory  test-memcheck, then the same tests under AddressSanitizer (nightly)
 #                      and a Python lifecycle through fmpy under valgrind
 #   make soak          the soak test's figures (it also runs in `cargo test`)
-# `make test` runs `fuzz` for a minute and `test-memcheck`; the longer runs are separate.
+# `make test` runs `fuzz` for 40 s and `test-memcheck`; the longer runs are separate.
 # Installs what is missing: cargo-fuzz (pinned) with cargo, valgrind with apt-get when root.
 
 FUZZ_SECONDS ?= 60
