@@ -42,8 +42,8 @@ all: fmu
 
 # Included before the rules so that the fragments' prerequisites are seen.
 include $(wildcard mk/*.mk)
-# The parts start longest first (in a fresh clone about 180, 140 and 70 s: the FMUs' pytest, the
-# fuzzer's build and run, the studies' pytest), the short ones after them.
+# The parts start longest first (the FMUs' pytest, the fuzzer's build and run, the studies'
+# pytest: docs/DEVELOPING.md has their times), the short ones after them.
 LONGEST_PARTS := test-python-fmus fuzz test-python-tools
 TEST_TARGETS := $(LONGEST_PARTS) $(filter-out $(LONGEST_PARTS),$(TEST_TARGETS))
 
@@ -122,10 +122,11 @@ test-rust: $(CAPI_LIB) | libclang
 
 test-python: $(PYTEST_PARTS)
 $(PYTEST_PARTS): fmu $(VENV)/.installed
+# Each part keeps its own pytest cache: the two run at the same time.
 test-python-fmus:
-	$(PY) -m pytest -q $(foreach d,$(PYTEST_LAST),--ignore-glob='$(d)/*')
+	$(PY) -m pytest -q -o cache_dir=.pytest_cache/$@ $(foreach d,$(PYTEST_LAST),--ignore-glob='$(d)/*')
 test-python-tools:
-	$(PY) -m pytest -q $(PYTEST_LAST)
+	$(PY) -m pytest -q -o cache_dir=.pytest_cache/$@ $(PYTEST_LAST)
 
 setup: libclang $(VENV)/.installed
 
